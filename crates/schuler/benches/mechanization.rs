@@ -1,1 +1,44 @@
-fn main() {}
+//! Criterion benchmarks of the strapdown mechanizations.
+//! Throughput of one strapdown mechanization step (issue 2: >= 5 million samples/s on
+//! one core). Samples are precomputed exact increments of a maneuvering flight at
+//! 200 Hz, so the timing is the mechanization alone.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use schuler::earth::{Geodetic, Sphere, Wgs84};
+use schuler::imu::ImuSample;
+use schuler::nav::{LocalLevel, Mechanization};
+use schuler::sim::analytic::{self, Maneuvering};
+use std::hint::black_box;
+
+const N: usize = 20_000;
+
+fn bench_local_level(c: &mut Criterion) {
+    let traj = Maneuvering::flight(Geodetic::from_degrees(30.5, 114.3, 500.0));
+    let samples: Vec<ImuSample> = analytic::samples(&Wgs84, &traj, 0.0, 0.005, N).collect();
+    let start = analytic::state(&Wgs84, &traj, 0.0);
+    let mut group = c.benchmark_group("mechanization");
+    group.throughput(Throughput::Elements(N as u64));
+    group.bench_function("local_level_wgs84", |b| {
+        b.iter(|| {
+            let mut nav = LocalLevel::new(Wgs84, start);
+            for s in &samples {
+                nav.step(black_box(s));
+            }
+            black_box(nav.state())
+        })
+    });
+    let sphere = Sphere::textbook(true);
+    group.bench_function("local_level_sphere", |b| {
+        b.iter(|| {
+            let mut nav = LocalLevel::new(sphere, start);
+            for s in &samples {
+                nav.step(black_box(s));
+            }
+            black_box(nav.state())
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_local_level);
+criterion_main!(benches);

@@ -1,8 +1,12 @@
 //! schuler: an inertial navigation toolkit.
 //!
 //! SI units and radians inside, `f64` everywhere; engineering units only at the edges
-//! through [`units`]. Frames: body = front-right-down (FRD), navigation = north-east-down
+//! through `units`. Frames: body = front-right-down (FRD), navigation = north-east-down
 //! (NED); DCMs are named `c_xy` for the transformation from frame `x` to frame `y`
 //! (`v_n = c_bn * v_b`).
 
+pub mod earth;
 pub mod imu;
+pub mod nav;
+pub mod rotation;
+pub mod sim;

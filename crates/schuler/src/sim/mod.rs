@@ -1,0 +1,4 @@
+//! Simulation: trajectories with exact truth and the IMU increments they produce.
+
+pub mod analytic;
+pub mod jet;
