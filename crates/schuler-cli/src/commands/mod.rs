@@ -1,0 +1,5 @@
+//! One module per `schuler` subcommand: each parses its arguments and wires library
+//! calls to readers and writers.
+
+pub mod demo;
+pub mod nav;

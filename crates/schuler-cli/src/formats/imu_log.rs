@@ -1,0 +1,1750 @@
+//! Streaming IMU log readers: KF-GINS text and our CSV, to [`ImuSample`]s.
+//!
+//! # Formats
+//! - **KF-GINS text** (also the awesome-gins-datasets IMU files): one sample per line,
+//!   7 numbers separated by blanks (spaces or tabs, repeated) or commas (with optional
+//!   blanks around them): `t` [s, GPS seconds of week], `dtheta_x y z` [rad],
+//!   `dvel_x y z` [m/s], body axes FRD. Each line holds the increments over
+//!   `(t_prev, t]`, `t_prev` the previous line's time. With [`ImuLayout::Rates`] the
+//!   same columns are read as angular rate `w_x y z` [rad/s] and specific force
+//!   `f_x y z` [m/s²].
+//! - **CSV** (our native format): a header row, then comma-separated rows with as many
+//!   fields as the header. Columns are found by name (ASCII case-insensitive, blanks and
+//!   double quotes around a name ignored): `t` (or `time`), then either increments
+//!   `dtheta_x, dtheta_y, dtheta_z, dvel_x, dvel_y, dvel_z` [rad, m/s] or rates
+//!   `w_x, w_y, w_z, f_x, f_y, f_z` [rad/s, m/s²]. Order is free, other columns are
+//!   ignored (and not parsed), missing ones are an error naming them. A header with
+//!   both sets reads increments unless [`ImuReadOptions::layout`] says rates. Quoted
+//!   data fields are not supported.
+//!
+//! In both, blank lines and lines whose first non-blank byte is `#` or `%` are skipped,
+//! a UTF-8 byte-order mark and `\r\n` line ends are accepted, and line numbers in
+//! errors count every line of the file (1-based).
+//!
+//! # Time and increments
+//! A sample's `dt = t - t_prev`. The first sample of a file has no predecessor: it gets
+//! `dt` = the nominal interval, and navigation starts **at** the first sample's time
+//! (its state is the initial state at `t`), so that sample's increment is never
+//! integrated. With a time window the first yielded sample usually has a predecessor
+//! (skipped) and gets its true `dt`; navigation starting at it does not integrate it
+//! either.
+//!
+//! Rates are converted to increments explicitly: a rate sample tagged `t` is taken as
+//! the mean rate over `(t_prev, t]`, so `dtheta = w * dt` and `dvel = f * dt`
+//! (rectangular rule; the first sample uses the nominal `dt`).
+//!
+//! # Checks
+//! Every problem is an [`InputError`] naming the file, the line and the field, never a
+//! panic; the first error ends the iteration.
+//! - wrong column count, empty or non-numeric field, NaN or ±Inf (also overflow);
+//! - time going backwards or repeating (both times and lines named);
+//! - rates where increments are expected and the reverse (see [`ImuReadOptions::check_layout`]);
+//! - a line over 64 KiB (bounds memory on a file without newlines).
+//!
+//! Gaps (an interval longer than [`GAP_FACTOR`] nominal intervals) are not errors:
+//! the sample is yielded with its true `dt` and the gap counted in a [`GapReport`].
+//!
+//! # Nominal interval
+//! Given by the caller ([`ImuReadOptions::nominal_dt`]) or estimated as the median of
+//! the first up to [`LOOKAHEAD_INTERVALS`] intervals. The reader parses that many
+//! samples ahead at construction (about 13 KiB), so memory stays constant.
+//!
+//! # Speed
+//! Lines are read into one reused buffer with `read_until`, fields split by hand and
+//! parsed with `fast-float2`; nothing is allocated per line.
+
+use std::collections::VecDeque;
+use std::fmt;
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use nalgebra::Vector3;
+use schuler::imu::ImuSample;
+
+use super::error::{InputError, InputErrorKind, quote_field};
+use super::lines::{LineReadError, LineReader, MAX_LINE_BYTES, is_blank, is_skippable};
+
+/// Standard gravity g₀ [m/s²] (CGPM 1901), the yardstick of the layout check.
+pub const STANDARD_GRAVITY: f64 = 9.806_65;
+
+/// Intervals parsed ahead at construction to estimate the nominal interval and check
+/// the layout (201 samples).
+pub const LOOKAHEAD_INTERVALS: usize = 200;
+
+/// An interval longer than this many nominal intervals counts as a gap.
+pub const GAP_FACTOR: f64 = 2.0;
+
+/// Fewest lookahead intervals for the layout check to run; below it the check is
+/// skipped (a median of fewer samples says too little).
+pub const LAYOUT_CHECK_MIN_INTERVALS: usize = 10;
+
+/// Range [g₀] of a plausible median specific-force magnitude over the first samples.
+///
+/// A vehicle, at rest or moving, feels gravity plus its own acceleration: the median
+/// `|f|` over a second or so sits near 1 g₀ and, outside free fall or a centrifuge,
+/// within 0.3–3 g₀.
+pub const PLAUSIBLE_SPECIFIC_FORCE_G: (f64, f64) = (0.3, 3.0);
+
+/// Median `|f|` [g₀] above which the increment hypothesis is rejected: rates read as
+/// increments give `|f| ≈ g₀/dt` (200 g₀ at 200 Hz); no vehicle this reader serves
+/// sustains 5 g₀ for its median. Rejected only if the rate hypothesis is plausible,
+/// so a 1 Hz log (where both read alike) never trips it.
+pub const IMPLAUSIBLY_HIGH_G: f64 = 5.0;
+
+/// Median `|f|` [g₀] below which the rate hypothesis is rejected: increments read as
+/// rates give `|f| ≈ g₀·dt` (0.005 g₀ at 200 Hz); the mirror of [`IMPLAUSIBLY_HIGH_G`].
+pub const IMPLAUSIBLY_LOW_G: f64 = 0.2;
+
+/// Read buffer for files [bytes].
+pub const READ_BUFFER_BYTES: usize = 1 << 20;
+
+/// Which text format a log is in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ImuFormat {
+    /// Decide from the first non-comment line: a number first means KF-GINS text,
+    /// anything else a CSV header.
+    #[default]
+    Auto,
+    /// KF-GINS / awesome-gins-datasets: 7 numeric columns, no header.
+    KfGinsText,
+    /// CSV with a header naming the columns.
+    Csv,
+}
+
+/// Whether a log's six sensor columns hold increments or rates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImuLayout {
+    /// Angle increments [rad] and velocity increments [m/s] over `(t_prev, t]`.
+    Increments,
+    /// Angular rate [rad/s] and specific force [m/s²], each the mean over `(t_prev, t]`.
+    Rates,
+}
+
+impl fmt::Display for ImuLayout {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Increments => "increments",
+            Self::Rates => "rates",
+        })
+    }
+}
+
+/// How to read an IMU log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuReadOptions {
+    /// The file format.
+    pub format: ImuFormat,
+    /// The layout; `None`: increments for KF-GINS text, the header's columns for CSV.
+    pub layout: Option<ImuLayout>,
+    /// Nominal sample interval [s]; `None`: median of the first intervals.
+    pub nominal_dt: Option<f64>,
+    /// Skip samples with `t < t_start` [s, log clock], checking only their time.
+    pub t_start: Option<f64>,
+    /// Stop at the first sample with `t > t_end` [s, log clock].
+    pub t_end: Option<f64>,
+    /// Reject logs whose accelerometer values look like the other layout (default on;
+    /// turn off for free fall, centrifuges or other > 3 g₀ / < 0.3 g₀ starts).
+    pub check_layout: bool,
+}
+
+impl Default for ImuReadOptions {
+    fn default() -> Self {
+        Self {
+            format: ImuFormat::Auto,
+            layout: None,
+            nominal_dt: None,
+            t_start: None,
+            t_end: None,
+            check_layout: true,
+        }
+    }
+}
+
+/// Gaps met so far: intervals longer than [`GAP_FACTOR`] nominal intervals ending at a
+/// yielded sample.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GapReport {
+    /// Number of gaps.
+    pub count: u64,
+    /// Longest gap [s] (0 if none).
+    pub longest_s: f64,
+    /// Time [s] of the sample ending the longest gap.
+    pub longest_at_t: Option<f64>,
+    /// Time [s] of the sample ending the first gap.
+    pub first_at_t: Option<f64>,
+    /// Threshold [s]: an interval longer than this is a gap.
+    pub threshold_s: f64,
+}
+
+impl GapReport {
+    /// Whether no gap was met.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    fn record(&mut self, t: f64, dt: f64) {
+        self.count += 1;
+        if self.first_at_t.is_none() {
+            self.first_at_t = Some(t);
+        }
+        if dt > self.longest_s {
+            self.longest_s = dt;
+            self.longest_at_t = Some(t);
+        }
+    }
+}
+
+impl fmt::Display for GapReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} gap(s) longer than {} s",
+            self.count, self.threshold_s
+        )?;
+        if let (Some(first), Some(longest_at)) = (self.first_at_t, self.longest_at_t) {
+            write!(
+                f,
+                "; first ending at t = {first}, longest {} s ending at t = {longest_at}",
+                self.longest_s
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// A cloneable handle on a reader's count of bytes consumed, for a progress bar on
+/// another thread or after the reader has moved into an iterator chain.
+#[derive(Debug, Clone)]
+pub struct ProgressCounter(Arc<AtomicU64>);
+
+impl ProgressCounter {
+    /// Bytes consumed so far (a recent value).
+    pub fn bytes(&self) -> u64 {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// Canonical column names, slot order: time, gyro xyz, accelerometer xyz.
+const INCREMENT_NAMES: [&str; 7] = [
+    "t", "dtheta_x", "dtheta_y", "dtheta_z", "dvel_x", "dvel_y", "dvel_z",
+];
+const RATE_NAMES: [&str; 7] = ["t", "w_x", "w_y", "w_z", "f_x", "f_y", "f_z"];
+const TEXT_COLUMNS: usize = 7;
+/// Marks a CSV column the reader does not use.
+const UNUSED: u8 = u8::MAX;
+
+/// How a line's fields map to slots.
+enum Columns {
+    /// KF-GINS text: 7 fixed columns in slot order.
+    Text,
+    /// CSV: `slot_of_col[i]` is column i's slot (0 time, 1–6 sensors) or [`UNUSED`].
+    Csv {
+        slot_of_col: Vec<u8>,
+        names: Vec<String>,
+        time_col: usize,
+    },
+}
+
+/// A field-level parse failure, before the file and names are attached.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum FieldError {
+    Columns {
+        found: usize,
+    },
+    Empty {
+        col: usize,
+    },
+    NotANumber {
+        col: usize,
+        start: usize,
+        end: usize,
+    },
+    NotFinite {
+        col: usize,
+        start: usize,
+        end: usize,
+    },
+}
+
+/// One parsed line: time and the six sensor values as written (not yet scaled).
+#[derive(Debug, Clone, Copy)]
+struct Record {
+    t: f64,
+    v: [f64; 6],
+}
+
+#[inline]
+fn skip_blanks(line: &[u8], mut pos: usize) -> usize {
+    while pos < line.len() && is_blank(line[pos]) {
+        pos += 1;
+    }
+    pos
+}
+
+/// Parses a number at `line[start..]` that ends at a blank, a comma or the line end;
+/// returns it and the index just past it.
+#[inline]
+fn parse_number(line: &[u8], start: usize, col: usize) -> Result<(f64, usize), FieldError> {
+    let rest = &line[start..];
+    match fast_float2::parse_partial::<f64, _>(rest) {
+        Ok((v, n)) if n > 0 && rest.get(n).is_none_or(|&b| is_blank(b) || b == b',') => {
+            if v.is_finite() {
+                Ok((v, start + n))
+            } else {
+                Err(FieldError::NotFinite {
+                    col,
+                    start,
+                    end: start + n,
+                })
+            }
+        }
+        _ => Err(FieldError::NotANumber {
+            col,
+            start,
+            end: start,
+        }),
+    }
+}
+
+/// Text format: skips one separator (blanks, at most one comma, blanks).
+#[inline]
+fn skip_text_separator(line: &[u8], pos: usize) -> usize {
+    let pos = skip_blanks(line, pos);
+    if pos < line.len() && line[pos] == b',' {
+        skip_blanks(line, pos + 1)
+    } else {
+        pos
+    }
+}
+
+/// Text format: end of the field starting at `start` (next blank, comma or line end).
+fn text_field_end(line: &[u8], start: usize) -> usize {
+    line[start..]
+        .iter()
+        .position(|&b| is_blank(b) || b == b',')
+        .map_or(line.len(), |n| start + n)
+}
+
+/// Text format: number of fields on a line (an empty field between two commas counts).
+fn count_text_fields(line: &[u8]) -> usize {
+    let mut n = 0;
+    let mut pos = skip_blanks(line, 0);
+    while pos < line.len() {
+        n += 1;
+        if line[pos] != b',' {
+            pos = text_field_end(line, pos);
+        }
+        pos = skip_text_separator(line, pos);
+    }
+    n
+}
+
+/// Text format: parses the first `ncols` of 7 columns into `out`, and with `ncols == 7`
+/// checks that nothing follows. A trailing separator is accepted.
+#[inline]
+fn parse_text_line(line: &[u8], ncols: usize, out: &mut [f64; 7]) -> Result<(), FieldError> {
+    let mut pos = skip_blanks(line, 0);
+    for (col, slot) in out.iter_mut().enumerate().take(ncols) {
+        let res = if pos >= line.len() {
+            Err(FieldError::Columns { found: col })
+        } else if line[pos] == b',' {
+            Err(FieldError::Empty { col })
+        } else {
+            parse_number(line, pos, col)
+        };
+        match res {
+            Ok((v, end)) => {
+                *slot = v;
+                pos = skip_text_separator(line, end);
+            }
+            Err(e) => return Err(text_error(line, e)),
+        }
+    }
+    if ncols == TEXT_COLUMNS && pos < line.len() {
+        return Err(FieldError::Columns {
+            found: count_text_fields(line),
+        });
+    }
+    Ok(())
+}
+
+/// Text format: a wrong column count outranks a bad field; fills in a bad field's end.
+#[cold]
+fn text_error(line: &[u8], e: FieldError) -> FieldError {
+    let found = count_text_fields(line);
+    if found != TEXT_COLUMNS {
+        return FieldError::Columns { found };
+    }
+    match e {
+        FieldError::NotANumber { col, start, .. } => FieldError::NotANumber {
+            col,
+            start,
+            end: text_field_end(line, start),
+        },
+        other => other,
+    }
+}
+
+/// CSV: number of fields (commas + 1).
+fn count_csv_fields(line: &[u8]) -> usize {
+    line.iter().filter(|&&b| b == b',').count() + 1
+}
+
+/// CSV: the field at `start` trimmed of blanks: `(start, end)`.
+fn csv_field_bounds(line: &[u8], start: usize) -> (usize, usize) {
+    let end = line[start..]
+        .iter()
+        .position(|&b| b == b',')
+        .map_or(line.len(), |n| start + n);
+    let s = skip_blanks(line, start).min(end);
+    let mut e = end;
+    while e > s && is_blank(line[e - 1]) {
+        e -= 1;
+    }
+    (s, e)
+}
+
+/// CSV: parses the used columns of a row into `out` by `slot_of_col`. With
+/// `time_only`, parses the time column and stops there (no column count check).
+#[inline]
+fn parse_csv_line(
+    line: &[u8],
+    slot_of_col: &[u8],
+    time_only: bool,
+    out: &mut [f64; 7],
+) -> Result<(), FieldError> {
+    let len = line.len();
+    // Start of the current field; `len + 1` once the line has no more fields.
+    let mut pos = 0;
+    for (col, &slot) in slot_of_col.iter().enumerate() {
+        if pos > len {
+            return Err(csv_error(
+                line,
+                slot_of_col.len(),
+                FieldError::Columns { found: col },
+            ));
+        }
+        let wanted = if time_only { slot == 0 } else { slot != UNUSED };
+        let next = if wanted {
+            let start = skip_blanks(line, pos);
+            if start >= len || line[start] == b',' {
+                return Err(csv_error(
+                    line,
+                    slot_of_col.len(),
+                    FieldError::Empty { col },
+                ));
+            }
+            let (v, end) = match parse_number(line, start, col) {
+                Ok(ok) => ok,
+                Err(e) => return Err(csv_error(line, slot_of_col.len(), e)),
+            };
+            let end = skip_blanks(line, end);
+            if end < len && line[end] != b',' {
+                let e = FieldError::NotANumber {
+                    col,
+                    start,
+                    end: start,
+                };
+                return Err(csv_error(line, slot_of_col.len(), e));
+            }
+            out[usize::from(slot)] = v;
+            if time_only {
+                return Ok(());
+            }
+            end
+        } else {
+            line[pos..]
+                .iter()
+                .position(|&b| b == b',')
+                .map_or(len, |n| pos + n)
+        };
+        pos = next + 1;
+    }
+    if pos <= len {
+        return Err(FieldError::Columns {
+            found: count_csv_fields(line),
+        });
+    }
+    Ok(())
+}
+
+/// CSV: a wrong column count outranks a bad field; fills in a bad field's bounds.
+#[cold]
+fn csv_error(line: &[u8], ncols: usize, e: FieldError) -> FieldError {
+    let found = count_csv_fields(line);
+    if found != ncols {
+        return FieldError::Columns { found };
+    }
+    match e {
+        FieldError::NotANumber { col, start, .. } => {
+            let (start, end) = csv_field_bounds(line, start);
+            FieldError::NotANumber { col, start, end }
+        }
+        other => other,
+    }
+}
+
+/// Median of `values` (sorted in place); `None` if empty.
+fn median(values: &mut [f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_unstable_by(f64::total_cmp);
+    let n = values.len();
+    Some(if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    })
+}
+
+/// A lazy, constant-memory reader of an IMU log, yielding increments.
+///
+/// Iterating yields `Ok(sample)` per data line in the time window, or one `Err` and
+/// then nothing.
+pub struct ImuReader<R> {
+    lines: LineReader<R>,
+    path: PathBuf,
+    format: ImuFormat,
+    columns: Columns,
+    layout: ImuLayout,
+    nominal_dt: f64,
+    t_start: Option<f64>,
+    t_end: Option<f64>,
+    /// Samples parsed at construction, not yet yielded.
+    lookahead: VecDeque<Record>,
+    /// Time and line of the last parsed record (monotonic check).
+    last: Option<(f64, u64)>,
+    /// Time of the last record handed to the window logic (for `dt`).
+    prev_t: Option<f64>,
+    /// Whether a record with `t >= t_start` has been met.
+    reached_start: bool,
+    /// Line of the first data line (0 before it is read).
+    first_data_line: u64,
+    /// Whether the format was detected as CSV (for a hint in header errors).
+    csv_auto_detected: bool,
+    gaps: GapReport,
+    finished: bool,
+}
+
+impl ImuReader<BufReader<File>> {
+    /// Opens the file at `path` behind a [`READ_BUFFER_BYTES`] buffer and reads its
+    /// first samples (see [`ImuReader::new`]).
+    pub fn open(path: &Path, options: &ImuReadOptions) -> Result<Self, InputError> {
+        let file = File::open(path).map_err(|e| {
+            InputError::new(
+                InputErrorKind::Io,
+                path,
+                0,
+                None,
+                format!("cannot open: {e}"),
+            )
+        })?;
+        Self::new(
+            BufReader::with_capacity(READ_BUFFER_BYTES, file),
+            path,
+            options,
+        )
+    }
+}
+
+impl<R: BufRead> ImuReader<R> {
+    /// Wraps `input` (named `path` in errors, e.g. `<stdin>`), reads the CSV header if
+    /// any and the first up to [`LOOKAHEAD_INTERVALS`] + 1 samples, fixes the nominal
+    /// interval and runs the layout check.
+    ///
+    /// For standard input, wrap it in a [`BufReader`] of [`READ_BUFFER_BYTES`] for speed.
+    pub fn new(
+        input: R,
+        path: impl Into<PathBuf>,
+        options: &ImuReadOptions,
+    ) -> Result<Self, InputError> {
+        let path = path.into();
+        check_options(&path, options)?;
+        let mut reader = Self {
+            lines: LineReader::new(input),
+            path,
+            format: options.format,
+            columns: Columns::Text,
+            layout: options.layout.unwrap_or(ImuLayout::Increments),
+            nominal_dt: f64::NAN,
+            t_start: options.t_start,
+            t_end: options.t_end,
+            lookahead: VecDeque::with_capacity(LOOKAHEAD_INTERVALS + 1),
+            last: None,
+            prev_t: None,
+            reached_start: options.t_start.is_none(),
+            first_data_line: 0,
+            csv_auto_detected: false,
+            gaps: GapReport::default(),
+            finished: false,
+        };
+        // First content line: decides the format, and is the CSV header.
+        let mut first_is_data = false;
+        loop {
+            if !reader.next_line()? {
+                return Err(reader.error(InputErrorKind::NoData, 0, None, "holds no IMU samples"));
+            }
+            let line = reader.lines.line();
+            if is_skippable(line) {
+                continue;
+            }
+            if reader.format == ImuFormat::Auto {
+                let start = skip_blanks(line, 0);
+                // A non-finite number is still a number: a text file, with a bad line 1.
+                let not_a_number = matches!(
+                    parse_number(line, start, 0),
+                    Err(FieldError::NotANumber { .. })
+                );
+                reader.format = if not_a_number {
+                    reader.csv_auto_detected = true;
+                    ImuFormat::Csv
+                } else {
+                    ImuFormat::KfGinsText
+                };
+            }
+            if reader.format == ImuFormat::Csv {
+                reader.read_header(options.layout)?;
+            } else {
+                first_is_data = true;
+            }
+            break;
+        }
+        if first_is_data {
+            let record = reader.parse_current(false)?;
+            reader.lookahead.push_back(record);
+        }
+        while reader.lookahead.len() <= LOOKAHEAD_INTERVALS {
+            match reader.read_record(false)? {
+                Some(record) => reader.lookahead.push_back(record),
+                None => break,
+            }
+        }
+        reader.settle_nominal_dt(options.nominal_dt)?;
+        if options.check_layout {
+            reader.check_layout()?;
+        }
+        reader.gaps.threshold_s = GAP_FACTOR * reader.nominal_dt;
+        Ok(reader)
+    }
+
+    /// The format read (never [`ImuFormat::Auto`]).
+    pub fn format(&self) -> ImuFormat {
+        self.format
+    }
+
+    /// The layout read.
+    pub fn layout(&self) -> ImuLayout {
+        self.layout
+    }
+
+    /// The nominal sample interval [s], given or estimated.
+    pub fn nominal_dt(&self) -> f64 {
+        self.nominal_dt
+    }
+
+    /// Gaps met so far (see [`GapReport`]); complete once the iteration has ended.
+    pub fn gaps(&self) -> GapReport {
+        self.gaps
+    }
+
+    /// Bytes consumed from the input so far (including the lookahead).
+    pub fn bytes_read(&self) -> u64 {
+        self.lines.bytes()
+    }
+
+    /// A handle on the byte count that outlives borrows of the reader.
+    pub fn progress(&self) -> ProgressCounter {
+        ProgressCounter(self.lines.progress())
+    }
+
+    fn error(
+        &self,
+        kind: InputErrorKind,
+        line: u64,
+        field: Option<&str>,
+        message: impl Into<String>,
+    ) -> InputError {
+        InputError::new(kind, &self.path, line, field, message)
+    }
+
+    /// Advances to the next line; `Ok(false)` at the end.
+    fn next_line(&mut self) -> Result<bool, InputError> {
+        match self.lines.next_line() {
+            Ok(more) => Ok(more),
+            Err(LineReadError::Io(e)) => Err(self.error(
+                InputErrorKind::Io,
+                self.lines.line_no() + 1,
+                None,
+                format!("read failed: {e}"),
+            )),
+            Err(LineReadError::TooLong) => Err(self.error(
+                InputErrorKind::LineTooLong,
+                self.lines.line_no(),
+                None,
+                format!("line longer than {MAX_LINE_BYTES} bytes (is this a text IMU log?)"),
+            )),
+        }
+    }
+
+    /// Parses the current line as the CSV header.
+    fn read_header(&mut self, layout: Option<ImuLayout>) -> Result<(), InputError> {
+        let line_no = self.lines.line_no();
+        let line = self.lines.line();
+        let names: Vec<String> = line
+            .split(|&b| b == b',')
+            .map(|raw| {
+                let text = String::from_utf8_lossy(raw);
+                let text = text.trim_matches([' ', '\t']);
+                let text = text
+                    .strip_prefix('"')
+                    .and_then(|s| s.strip_suffix('"'))
+                    .unwrap_or(text);
+                text.trim().to_owned()
+            })
+            .collect();
+        let find = |wanted: &str| -> Vec<usize> {
+            let aliases: &[&str] = if wanted == "t" {
+                &["t", "time"]
+            } else {
+                &[wanted]
+            };
+            aliases
+                .iter()
+                .map(|alias| {
+                    (0..names.len())
+                        .filter(|&i| names[i].eq_ignore_ascii_case(alias))
+                        .collect::<Vec<_>>()
+                })
+                .find(|found| !found.is_empty())
+                .unwrap_or_default()
+        };
+        let missing = |all: &[&'static str; 7]| -> Vec<&'static str> {
+            all.iter().copied().filter(|n| find(n).is_empty()).collect()
+        };
+        let missing_inc = missing(&INCREMENT_NAMES);
+        let missing_rate = missing(&RATE_NAMES);
+        let chosen = match layout {
+            Some(l) => l,
+            None if missing_inc.is_empty() => ImuLayout::Increments,
+            None if missing_rate.is_empty() => ImuLayout::Rates,
+            None if missing_rate.len() < missing_inc.len() => ImuLayout::Rates,
+            None => ImuLayout::Increments,
+        };
+        let (set, missing) = match chosen {
+            ImuLayout::Increments => (&INCREMENT_NAMES, missing_inc),
+            ImuLayout::Rates => (&RATE_NAMES, missing_rate),
+        };
+        if !missing.is_empty() {
+            let detected = if self.csv_auto_detected {
+                "; this line was taken for a CSV header because its first field is not a number"
+            } else {
+                ""
+            };
+            let also = if layout.is_none() {
+                " (a CSV IMU log needs t (or time) and either dtheta_x, dtheta_y, dtheta_z, \
+                 dvel_x, dvel_y, dvel_z or w_x, w_y, w_z, f_x, f_y, f_z)"
+            } else {
+                ""
+            };
+            return Err(self.error(
+                InputErrorKind::Header,
+                line_no,
+                None,
+                format!(
+                    "header lacks column(s) {} for {chosen}{also}{detected}",
+                    missing.join(", ")
+                ),
+            ));
+        }
+        let mut slot_of_col = vec![UNUSED; names.len()];
+        let mut time_col = 0;
+        for (slot, name) in set.iter().enumerate() {
+            let found = find(name);
+            if let [first, second, ..] = found[..] {
+                return Err(self.error(
+                    InputErrorKind::Header,
+                    line_no,
+                    Some(&names[first]),
+                    format!(
+                        "column appears twice (columns {} and {})",
+                        first + 1,
+                        second + 1
+                    ),
+                ));
+            }
+            // `missing` is empty, so every name was found exactly once here.
+            let col = found[0];
+            if slot == 0 {
+                time_col = col;
+            }
+            // `slot` < 7 fits a u8.
+            slot_of_col[col] = slot as u8;
+        }
+        self.layout = chosen;
+        self.columns = Columns::Csv {
+            slot_of_col,
+            names,
+            time_col,
+        };
+        Ok(())
+    }
+
+    /// Name of column `col` (0-based) for messages.
+    fn column_name(&self, col: usize) -> &str {
+        match &self.columns {
+            Columns::Text => match self.layout {
+                ImuLayout::Increments => INCREMENT_NAMES[col],
+                ImuLayout::Rates => RATE_NAMES[col],
+            },
+            Columns::Csv { names, .. } => &names[col],
+        }
+    }
+
+    /// Name of the time column.
+    fn time_name(&self) -> &str {
+        match &self.columns {
+            Columns::Text => "t",
+            Columns::Csv { time_col, .. } => self.column_name(*time_col),
+        }
+    }
+
+    #[cold]
+    fn field_error(&self, e: FieldError) -> InputError {
+        let line_no = self.lines.line_no();
+        let line = self.lines.line();
+        let expected = match &self.columns {
+            Columns::Text => TEXT_COLUMNS,
+            Columns::Csv { slot_of_col, .. } => slot_of_col.len(),
+        };
+        match e {
+            FieldError::Columns { found } => self.error(
+                InputErrorKind::ColumnCount,
+                line_no,
+                None,
+                format!("expected {expected} columns, found {found}"),
+            ),
+            FieldError::Empty { col } => self.error(
+                InputErrorKind::NotANumber,
+                line_no,
+                Some(self.column_name(col)),
+                "empty field",
+            ),
+            FieldError::NotANumber { col, start, end } => self.error(
+                InputErrorKind::NotANumber,
+                line_no,
+                Some(self.column_name(col)),
+                format!("not a number: {}", quote_field(&line[start..end])),
+            ),
+            FieldError::NotFinite { col, start, end } => self.error(
+                InputErrorKind::NotFinite,
+                line_no,
+                Some(self.column_name(col)),
+                format!("not finite: {}", quote_field(&line[start..end])),
+            ),
+        }
+    }
+
+    /// Parses the current line (a data line) into a record and checks its time
+    /// against the previous one. With `time_only`, only the time is parsed unless
+    /// it reaches `t_start`.
+    #[inline]
+    fn parse_current(&mut self, time_only: bool) -> Result<Record, InputError> {
+        let mut out = [0.0; 7];
+        let line = self.lines.line();
+        let parsed = match &self.columns {
+            Columns::Text => {
+                let first =
+                    parse_text_line(line, if time_only { 1 } else { TEXT_COLUMNS }, &mut out);
+                match (first, time_only) {
+                    (Ok(()), true) if self.t_start.is_some_and(|s| out[0] >= s) => {
+                        parse_text_line(line, TEXT_COLUMNS, &mut out)
+                    }
+                    (r, _) => r,
+                }
+            }
+            Columns::Csv { slot_of_col, .. } => {
+                let first = parse_csv_line(line, slot_of_col, time_only, &mut out);
+                match (first, time_only) {
+                    (Ok(()), true) if self.t_start.is_some_and(|s| out[0] >= s) => {
+                        parse_csv_line(line, slot_of_col, false, &mut out)
+                    }
+                    (r, _) => r,
+                }
+            }
+        };
+        if let Err(e) = parsed {
+            return Err(self.field_error(e));
+        }
+        let t = out[0];
+        let line_no = self.lines.line_no();
+        if let Some((t_prev, line_prev)) = self.last
+            && t <= t_prev
+        {
+            let what = if t == t_prev {
+                format!("time repeats: t = {t} also at line {line_prev}")
+            } else {
+                format!("time goes backwards: t = {t} after t = {t_prev} at line {line_prev}")
+            };
+            return Err(self.error(
+                InputErrorKind::TimeNotIncreasing,
+                line_no,
+                Some(self.time_name()),
+                what,
+            ));
+        }
+        if self.last.is_none() {
+            self.first_data_line = line_no;
+        }
+        self.last = Some((t, line_no));
+        Ok(Record {
+            t,
+            v: [out[1], out[2], out[3], out[4], out[5], out[6]],
+        })
+    }
+
+    /// Reads up to the next data line and parses it; `Ok(None)` at the end.
+    #[inline]
+    fn read_record(&mut self, time_only: bool) -> Result<Option<Record>, InputError> {
+        loop {
+            if !self.next_line()? {
+                return Ok(None);
+            }
+            if is_skippable(self.lines.line()) {
+                continue;
+            }
+            return self.parse_current(time_only).map(Some);
+        }
+    }
+
+    /// Intervals between the lookahead samples [s] (all > 0 by the monotonic check).
+    fn lookahead_intervals(&self) -> Vec<f64> {
+        self.lookahead
+            .iter()
+            .zip(self.lookahead.iter().skip(1))
+            .map(|(a, b)| b.t - a.t)
+            .collect()
+    }
+
+    fn settle_nominal_dt(&mut self, given: Option<f64>) -> Result<(), InputError> {
+        if let Some(dt) = given {
+            self.nominal_dt = dt;
+            return Ok(());
+        }
+        let mut intervals = self.lookahead_intervals();
+        match median(&mut intervals) {
+            Some(dt) => {
+                self.nominal_dt = dt;
+                Ok(())
+            }
+            None => Err(self.error(
+                InputErrorKind::Usage,
+                0,
+                None,
+                "only one sample: cannot estimate the sample interval; give it explicitly \
+                 (nominal_dt, e.g. --imu-rate)",
+            )),
+        }
+    }
+
+    /// Rejects a log whose accelerometer columns look like the other layout.
+    ///
+    /// Over the lookahead (sample i with interval `dt_i`, accelerometer columns `a_i`),
+    /// the median `|a_i| / dt_i` is the specific force if the columns are increments,
+    /// the median `|a_i|` if they are rates. Declared increments fail when the first is
+    /// above [`IMPLAUSIBLY_HIGH_G`] and the second within [`PLAUSIBLE_SPECIFIC_FORCE_G`];
+    /// declared rates fail when the second is below [`IMPLAUSIBLY_LOW_G`] and the first
+    /// plausible. Needs [`LAYOUT_CHECK_MIN_INTERVALS`].
+    fn check_layout(&self) -> Result<(), InputError> {
+        let n = self.lookahead.len().saturating_sub(1);
+        if n < LAYOUT_CHECK_MIN_INTERVALS {
+            return Ok(());
+        }
+        let mut as_increments = Vec::with_capacity(n);
+        let mut as_rates = Vec::with_capacity(n);
+        for (a, b) in self.lookahead.iter().zip(self.lookahead.iter().skip(1)) {
+            let norm = Vector3::new(b.v[3], b.v[4], b.v[5]).norm();
+            as_increments.push(norm / (b.t - a.t) / STANDARD_GRAVITY);
+            as_rates.push(norm / STANDARD_GRAVITY);
+        }
+        let (Some(g_inc), Some(g_rate)) = (median(&mut as_increments), median(&mut as_rates))
+        else {
+            return Ok(());
+        };
+        let plausible =
+            |g: f64| (PLAUSIBLE_SPECIFIC_FORCE_G.0..=PLAUSIBLE_SPECIFIC_FORCE_G.1).contains(&g);
+        let (looks_like, field, declared_g, other_g) = match self.layout {
+            ImuLayout::Increments if g_inc > IMPLAUSIBLY_HIGH_G && plausible(g_rate) => {
+                (ImuLayout::Rates, "dvel", g_inc, g_rate)
+            }
+            ImuLayout::Rates if g_rate < IMPLAUSIBLY_LOW_G && plausible(g_inc) => {
+                (ImuLayout::Increments, "f", g_rate, g_inc)
+            }
+            _ => return Ok(()),
+        };
+        let first_line = self.first_data_line;
+        let last_line = self.last.map_or(first_line, |(_, line)| line);
+        let declared = self.layout;
+        let field = match &self.columns {
+            Columns::Text => format!("{field} (columns 5-7)"),
+            Columns::Csv { .. } => format!("{field}_x, {field}_y, {field}_z"),
+        };
+        Err(self.error(
+            InputErrorKind::LayoutMismatch,
+            first_line,
+            Some(&field),
+            format!(
+                "lines {first_line}-{last_line} look like {looks_like}, not {declared}: read as \
+                 {declared} their median specific force is {declared_g:.3} g, read as \
+                 {looks_like} {other_g:.3} g (g = {STANDARD_GRAVITY} m/s^2; plausible \
+                 {}-{} g); read the file as {looks_like} (ImuLayout::{looks_like:?}) or turn \
+                 the layout check off",
+                PLAUSIBLE_SPECIFIC_FORCE_G.0, PLAUSIBLE_SPECIFIC_FORCE_G.1
+            ),
+        ))
+    }
+}
+
+/// Validates the caller's options.
+fn check_options(path: &Path, o: &ImuReadOptions) -> Result<(), InputError> {
+    let bad = |field: &str, message: String| {
+        Err(InputError::new(
+            InputErrorKind::Usage,
+            path,
+            0,
+            Some(field),
+            message,
+        ))
+    };
+    if let Some(dt) = o.nominal_dt
+        && !(dt.is_finite() && dt > 0.0)
+    {
+        return bad(
+            "nominal_dt",
+            format!("nominal sample interval must be > 0 s, got {dt}"),
+        );
+    }
+    for (name, t) in [("t_start", o.t_start), ("t_end", o.t_end)] {
+        if let Some(t) = t
+            && !t.is_finite()
+        {
+            return bad(name, format!("window bound must be finite, got {t}"));
+        }
+    }
+    if let (Some(s), Some(e)) = (o.t_start, o.t_end)
+        && s > e
+    {
+        return bad("t_start", format!("window start {s} is after its end {e}"));
+    }
+    Ok(())
+}
+
+impl<R: BufRead> std::iter::FusedIterator for ImuReader<R> {}
+
+impl<R: BufRead> Iterator for ImuReader<R> {
+    type Item = Result<ImuSample, InputError>;
+
+    #[inline]
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if self.finished {
+                return None;
+            }
+            let record = match self.lookahead.pop_front() {
+                Some(record) => record,
+                None => match self.read_record(!self.reached_start) {
+                    Ok(Some(record)) => record,
+                    Ok(None) => {
+                        self.finished = true;
+                        return None;
+                    }
+                    Err(e) => {
+                        self.finished = true;
+                        return Some(Err(e));
+                    }
+                },
+            };
+            let t = record.t;
+            let had_prev = self.prev_t.is_some();
+            let dt = self.prev_t.map_or(self.nominal_dt, |t_prev| t - t_prev);
+            self.prev_t = Some(t);
+            if !self.reached_start {
+                if self.t_start.is_some_and(|s| t < s) {
+                    continue;
+                }
+                self.reached_start = true;
+            }
+            if self.t_end.is_some_and(|e| t > e) {
+                self.finished = true;
+                return None;
+            }
+            if had_prev && dt > self.gaps.threshold_s {
+                self.gaps.record(t, dt);
+            }
+            let scale = match self.layout {
+                ImuLayout::Increments => 1.0,
+                ImuLayout::Rates => dt,
+            };
+            let v = record.v;
+            return Some(Ok(ImuSample {
+                t,
+                dt,
+                dtheta: Vector3::new(v[0], v[1], v[2]) * scale,
+                dvel: Vector3::new(v[3], v[4], v[5]) * scale,
+            }));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::fmt::Write as _;
+
+    const PATH: &str = "IMU.txt";
+
+    fn reader<'a>(
+        input: &'a str,
+        options: &ImuReadOptions,
+    ) -> Result<ImuReader<&'a [u8]>, InputError> {
+        ImuReader::new(input.as_bytes(), PATH, options)
+    }
+
+    /// All samples, or the first error whether from construction or iteration.
+    fn read_all(input: &str, options: &ImuReadOptions) -> Result<Vec<ImuSample>, InputError> {
+        reader(input, options)?.collect()
+    }
+
+    fn read_err(input: &str, options: &ImuReadOptions) -> InputError {
+        match read_all(input, options) {
+            Ok(samples) => panic!("expected an error, read {} samples", samples.len()),
+            Err(e) => e,
+        }
+    }
+
+    fn text() -> ImuReadOptions {
+        ImuReadOptions {
+            format: ImuFormat::KfGinsText,
+            ..ImuReadOptions::default()
+        }
+    }
+
+    /// A KF-GINS text log of `n` stationary samples at `rate_hz`, starting at `t0`,
+    /// with z-down specific force `-g` written as increments (`-g dt`) or rates (`-g`).
+    fn stationary_text(n: usize, rate_hz: f64, t0: f64, layout: ImuLayout) -> String {
+        let dt = 1.0 / rate_hz;
+        let mut s = String::new();
+        for i in 0..n {
+            let t = t0 + i as f64 * dt;
+            let k = match layout {
+                ImuLayout::Increments => dt,
+                ImuLayout::Rates => 1.0,
+            };
+            let w = 7.292115e-5 * k;
+            let fz = -9.8 * k;
+            // Small deterministic wobble, as a real sensor would show.
+            let wob = 1e-3 * k * ((i % 7) as f64 - 3.0);
+            writeln!(
+                s,
+                "{t:.6} {w:e} {:e} {:e} {wob:e} {:e} {fz:e}",
+                -w,
+                0.5 * w,
+                -wob
+            )
+            .expect("writing to a String cannot fail");
+        }
+        s
+    }
+
+    #[test]
+    fn good_text_file_parses_to_exact_values() {
+        let input = "# KF-GINS IMU file\n\
+                     % matlab-style comment\n\
+                     \n\
+                     456789.000 0.001 -0.002 3e-4 0.0049 -0.0051 -0.049\r\n\
+                     456789.005\t0.0011\t-0.0021  3.1e-4\t\t0.00491 -0.00511 -0.0491\n\
+                     \x20 456789.010 1 2 3 4 5 6   \n";
+        let samples = read_all(input, &text()).expect("good file");
+        assert_eq!(samples.len(), 3);
+        let s = &samples[1];
+        assert_eq!(s.t, 456789.005);
+        assert_eq!(s.dt, 456789.005 - 456789.000);
+        assert_eq!(s.dtheta, Vector3::new(0.0011, -0.0021, 3.1e-4));
+        assert_eq!(s.dvel, Vector3::new(0.00491, -0.00511, -0.0491));
+        assert_eq!(samples[2].dvel, Vector3::new(4.0, 5.0, 6.0));
+        // First sample: no predecessor, dt = nominal (median of the two intervals).
+        let r = reader(input, &text()).expect("good file");
+        let nominal = r.nominal_dt();
+        assert_eq!(
+            nominal,
+            0.5 * ((456789.005 - 456789.0) + (456789.010 - 456789.005))
+        );
+        assert_eq!(samples[0].dt, nominal);
+        assert_eq!(samples[0].dtheta, Vector3::new(0.001, -0.002, 3e-4));
+    }
+
+    #[test]
+    fn comma_and_blank_separators_read_alike() {
+        let blanks = "1.0 0.1 0.2 0.3 0.4 0.5 0.6\n1.5\t0.1 0.2\t 0.3 0.4 0.5 0.6\n";
+        let commas = "1.0,0.1,0.2,0.3,0.4,0.5,0.6\n1.5, 0.1 ,0.2,\t0.3,0.4,0.5,0.6,\n";
+        let a = read_all(blanks, &text()).expect("blanks");
+        let b = read_all(commas, &text()).expect("commas");
+        assert_eq!(a, b);
+        assert_eq!(a[1].dvel, Vector3::new(0.4, 0.5, 0.6));
+    }
+
+    #[test]
+    fn auto_detects_text_and_csv() {
+        let t = reader(
+            "# c\n1 0 0 0 0 0 0\n2 0 0 0 0 0 0\n",
+            &ImuReadOptions::default(),
+        )
+        .expect("text");
+        assert_eq!(t.format(), ImuFormat::KfGinsText);
+        let c = reader(
+            "t,dtheta_x,dtheta_y,dtheta_z,dvel_x,dvel_y,dvel_z\n1,0,0,0,0,0,0\n2,0,0,0,0,0,0\n",
+            &ImuReadOptions::default(),
+        )
+        .expect("csv");
+        assert_eq!(c.format(), ImuFormat::Csv);
+        assert_eq!(c.layout(), ImuLayout::Increments);
+    }
+
+    fn assert_err(e: &InputError, line: u64, field: Option<&str>, kind: InputErrorKind, msg: &str) {
+        assert_eq!(
+            (e.line, e.field.as_deref(), e.kind),
+            (line, field, kind),
+            "{e}"
+        );
+        assert!(e.message.contains(msg), "{e}");
+        assert_eq!(e.path, Path::new(PATH));
+    }
+
+    #[test]
+    fn bad_text_lines_name_line_and_field() {
+        let head = "# header\n1 0 0 0 0 0 0\n2 0 0 0 0 0 0\n";
+        let cases: [(&str, Option<&str>, InputErrorKind, &str); 10] = [
+            (
+                "3 0 0 0 0",
+                None,
+                InputErrorKind::ColumnCount,
+                "expected 7 columns, found 5",
+            ),
+            (
+                "3 0 0 0 0 0 0 9",
+                None,
+                InputErrorKind::ColumnCount,
+                "found 8",
+            ),
+            (
+                "3 0 0 0 0 abc 0",
+                Some("dvel_y"),
+                InputErrorKind::NotANumber,
+                "\"abc\"",
+            ),
+            (
+                "3 0 0 0 0 1.2.3 0",
+                Some("dvel_y"),
+                InputErrorKind::NotANumber,
+                "\"1.2.3\"",
+            ),
+            (
+                "3,0,,0,0,0,0",
+                Some("dtheta_y"),
+                InputErrorKind::NotANumber,
+                "empty field",
+            ),
+            (
+                "3 0 0 NaN 0 0 0",
+                Some("dtheta_z"),
+                InputErrorKind::NotFinite,
+                "\"NaN\"",
+            ),
+            (
+                "3 0 0 0 -inf 0 0",
+                Some("dvel_x"),
+                InputErrorKind::NotFinite,
+                "\"-inf\"",
+            ),
+            (
+                "3 1e999 0 0 0 0 0",
+                Some("dtheta_x"),
+                InputErrorKind::NotFinite,
+                "\"1e999\"",
+            ),
+            (
+                "x3 0 0 0 0 0 0",
+                Some("t"),
+                InputErrorKind::NotANumber,
+                "\"x3\"",
+            ),
+            (
+                "1.5 0 0 0 0 0 0",
+                Some("t"),
+                InputErrorKind::TimeNotIncreasing,
+                "t = 1.5 after t = 2 at line 3",
+            ),
+        ];
+        for (bad, field, kind, msg) in cases {
+            let input = format!("{head}{bad}\n5 0 0 0 0 0 0\n");
+            let e = read_err(&input, &text());
+            assert_err(&e, 4, field, kind, msg);
+        }
+        let e = read_err(&format!("{head}2 0 0 0 0 0 0\n"), &text());
+        assert_err(
+            &e,
+            4,
+            Some("t"),
+            InputErrorKind::TimeNotIncreasing,
+            "t = 2 also at line 3",
+        );
+        let e = read_err(&format!("{head}3 0 0 0 0 abc 0\n"), &text());
+        assert_eq!(
+            e.to_string(),
+            r#"IMU.txt:4: field dvel_y: not a number: "abc""#
+        );
+    }
+
+    #[test]
+    fn errors_after_the_lookahead_come_from_the_iterator() {
+        let mut input = stationary_text(500, 200.0, 100.0, ImuLayout::Increments);
+        input.push_str("103 0 0 0 0 0\n");
+        let mut r = reader(&input, &text()).expect("first 201 lines are good");
+        let mut n = 0;
+        let e = loop {
+            match r.next() {
+                Some(Ok(_)) => n += 1,
+                Some(Err(e)) => break e,
+                None => panic!("no error"),
+            }
+        };
+        assert_eq!(n, 500);
+        assert_err(
+            &e,
+            501,
+            None,
+            InputErrorKind::ColumnCount,
+            "expected 7 columns, found 6",
+        );
+        assert!(r.next().is_none(), "the first error ends the iteration");
+    }
+
+    #[test]
+    fn auto_detection_explains_itself() {
+        let e = read_err("nan 0 0 0 0 0 0\n", &ImuReadOptions::default());
+        assert_err(&e, 1, Some("t"), InputErrorKind::NotFinite, "\"nan\"");
+        let e = read_err("# c\nabc 0 0 0 0 0 0\n", &ImuReadOptions::default());
+        assert_err(
+            &e,
+            2,
+            None,
+            InputErrorKind::Header,
+            "first field is not a number",
+        );
+    }
+
+    #[test]
+    fn empty_and_single_sample_files() {
+        let e = read_err("# nothing\n\n", &text());
+        assert_eq!(e.kind, InputErrorKind::NoData);
+        let e = read_err("1 0 0 0 0 0 0\n", &text());
+        assert_eq!(e.kind, InputErrorKind::Usage);
+        let one = ImuReadOptions {
+            nominal_dt: Some(0.01),
+            ..text()
+        };
+        let s = read_all("1 0 0 0 0 0 0\n", &one).expect("nominal given");
+        assert_eq!(s[0].dt, 0.01);
+        let bad = ImuReadOptions {
+            nominal_dt: Some(-1.0),
+            ..text()
+        };
+        assert_eq!(
+            read_err("1 0 0 0 0 0 0\n", &bad).field.as_deref(),
+            Some("nominal_dt")
+        );
+    }
+
+    #[test]
+    fn gaps_are_counted_not_errors() {
+        let mut input = String::new();
+        let mut t = 10.0;
+        for i in 0..400 {
+            t += match i {
+                100 => 0.05,
+                250 => 0.021,
+                300 => 0.02, // exactly 2 nominal intervals: not a gap
+                _ => 0.01,
+            };
+            writeln!(input, "{t:.3} 0 0 0 0 0 -0.098").expect("String");
+        }
+        let options = ImuReadOptions {
+            nominal_dt: Some(0.01),
+            ..text()
+        };
+        let mut r = reader(&input, &options).expect("good");
+        let samples: Vec<_> = r
+            .by_ref()
+            .collect::<Result<_, _>>()
+            .expect("gaps are no error");
+        assert_eq!(samples.len(), 400);
+        assert!((samples[100].dt - 0.05).abs() < 1e-9, "true dt kept");
+        let gaps = r.gaps();
+        assert_eq!(gaps.count, 2);
+        assert!((gaps.longest_s - 0.05).abs() < 1e-9);
+        assert_eq!(gaps.longest_at_t, Some(samples[100].t));
+        assert_eq!(gaps.first_at_t, Some(samples[100].t));
+        assert_eq!(gaps.threshold_s, 0.02);
+        assert!(
+            gaps.to_string().starts_with("2 gap(s) longer than 0.02 s"),
+            "{gaps}"
+        );
+        assert_eq!(r.bytes_read(), input.len() as u64);
+    }
+
+    #[test]
+    fn rates_in_an_increment_file_are_detected() {
+        let rates = stationary_text(300, 200.0, 1000.0, ImuLayout::Rates);
+        let e = read_err(&rates, &text());
+        assert_eq!(e.kind, InputErrorKind::LayoutMismatch, "{e}");
+        assert_eq!(e.line, 1);
+        assert_eq!(e.field.as_deref(), Some("dvel (columns 5-7)"));
+        assert!(
+            e.message
+                .contains("lines 1-201 look like rates, not increments"),
+            "{e}"
+        );
+        assert!(e.message.contains("ImuLayout::Rates"), "{e}");
+        // Read as declared rates, the same file is fine and converts to increments.
+        let as_rates = ImuReadOptions {
+            layout: Some(ImuLayout::Rates),
+            ..text()
+        };
+        let s = read_all(&rates, &as_rates).expect("rates");
+        assert!((s[10].dvel.z - (-9.8 * s[10].dt)).abs() < 1e-12);
+        // The check can be turned off.
+        let unchecked = ImuReadOptions {
+            check_layout: false,
+            ..text()
+        };
+        assert!(read_all(&rates, &unchecked).is_ok());
+    }
+
+    #[test]
+    fn increments_declared_as_rates_are_detected() {
+        let increments = stationary_text(300, 200.0, 1000.0, ImuLayout::Increments);
+        assert!(read_all(&increments, &text()).is_ok());
+        let as_rates = ImuReadOptions {
+            layout: Some(ImuLayout::Rates),
+            ..text()
+        };
+        let e = read_err(&increments, &as_rates);
+        assert_eq!(e.kind, InputErrorKind::LayoutMismatch, "{e}");
+        assert_eq!(e.field.as_deref(), Some("f (columns 5-7)"));
+        assert!(e.message.contains("look like increments, not rates"), "{e}");
+    }
+
+    #[test]
+    fn layout_check_is_silent_at_one_hertz() {
+        // At dt = 1 s both readings agree: nothing to reject either way.
+        let s = stationary_text(30, 1.0, 0.0, ImuLayout::Rates);
+        assert!(read_all(&s, &text()).is_ok());
+        let as_rates = ImuReadOptions {
+            layout: Some(ImuLayout::Rates),
+            ..text()
+        };
+        assert!(read_all(&s, &as_rates).is_ok());
+    }
+
+    #[test]
+    fn csv_with_rates_converts_to_increments() {
+        let input = "# our CSV\n\
+                     f_z, label, \"TIME\" ,w_x,w_y,w_z,f_x,f_y\n\
+                     -9.8,a,100.00,0.01,0.02,0.03,0.1,0.2\n\
+                     -9.7,b,100.01,0.02,0.04,0.06,0.2,0.4\n\
+                     -9.6,,100.03,0.03,0.06,0.09,0.3,0.6\n";
+        let options = ImuReadOptions {
+            format: ImuFormat::Csv,
+            ..ImuReadOptions::default()
+        };
+        let r = reader(input, &options).expect("header has the rate set");
+        assert_eq!(r.layout(), ImuLayout::Rates);
+        let nominal = r.nominal_dt();
+        let s: Vec<_> = r.collect::<Result<_, _>>().expect("good");
+        assert_eq!(s.len(), 3);
+        let dt = 100.01 - 100.00;
+        assert_eq!(s[1].dt, dt);
+        assert_eq!(s[1].dtheta, Vector3::new(0.02 * dt, 0.04 * dt, 0.06 * dt));
+        assert_eq!(s[1].dvel, Vector3::new(0.2 * dt, 0.4 * dt, -9.7 * dt));
+        assert_eq!(s[2].dt, 100.03 - 100.01);
+        assert_eq!(s[0].dt, nominal);
+        assert_eq!(s[0].dvel.z, -9.8 * nominal);
+    }
+
+    #[test]
+    fn csv_with_increments_in_free_order() {
+        let input = "dvel_z,dvel_y,dvel_x,dtheta_z,dtheta_y,dtheta_x,t,extra\n\
+                     6,5,4,3,2,1,0.5,x\n\
+                     6.5,5.5,4.5,3.5,2.5,1.5,1.0,y\n";
+        let s = read_all(input, &ImuReadOptions::default()).expect("good");
+        assert_eq!(s[1].t, 1.0);
+        assert_eq!(s[1].dtheta, Vector3::new(1.5, 2.5, 3.5));
+        assert_eq!(s[1].dvel, Vector3::new(4.5, 5.5, 6.5));
+    }
+
+    #[test]
+    fn csv_errors_name_columns() {
+        let e = read_err(
+            "t,dtheta_x,dtheta_y,dtheta_z,dvel_x\n1,0,0,0,0\n",
+            &ImuReadOptions::default(),
+        );
+        assert_err(
+            &e,
+            1,
+            None,
+            InputErrorKind::Header,
+            "lacks column(s) dvel_y, dvel_z for increments",
+        );
+        let rates = ImuReadOptions {
+            layout: Some(ImuLayout::Rates),
+            ..ImuReadOptions::default()
+        };
+        let e = read_err("t,w_x,w_y,f_x,f_y,f_z\n", &rates);
+        assert_err(
+            &e,
+            1,
+            None,
+            InputErrorKind::Header,
+            "lacks column(s) w_z for rates",
+        );
+        let e = read_err(
+            "t,w_x,w_y,w_z,f_x,f_y,f_z,w_y\n",
+            &ImuReadOptions::default(),
+        );
+        assert_err(
+            &e,
+            1,
+            Some("w_y"),
+            InputErrorKind::Header,
+            "columns 3 and 8",
+        );
+        let head = "time,w_x,w_y,w_z,f_x,f_y,f_z,note\n1,0,0,0,0,0,9.8,a\n2,0,0,0,0,0,9.8,b\n";
+        let cases: [(&str, Option<&str>, InputErrorKind, &str); 6] = [
+            (
+                "3,0,0,0,0,0",
+                None,
+                InputErrorKind::ColumnCount,
+                "expected 8 columns, found 6",
+            ),
+            (
+                "3,0,0,0,0,0,9.8,c,d",
+                None,
+                InputErrorKind::ColumnCount,
+                "found 9",
+            ),
+            (
+                "3,0,0,0,0,9 8,9.8,c",
+                Some("f_y"),
+                InputErrorKind::NotANumber,
+                "\"9 8\"",
+            ),
+            (
+                "3,0,0,0,0, ,9.8,c",
+                Some("f_y"),
+                InputErrorKind::NotANumber,
+                "empty field",
+            ),
+            (
+                "3,0,0,0,0,0,inf,c",
+                Some("f_z"),
+                InputErrorKind::NotFinite,
+                "\"inf\"",
+            ),
+            (
+                "2,0,0,0,0,0,9.8,c",
+                Some("time"),
+                InputErrorKind::TimeNotIncreasing,
+                "t = 2 also at line 3",
+            ),
+        ];
+        for (bad, field, kind, msg) in cases {
+            let e = read_err(&format!("{head}{bad}\n"), &ImuReadOptions::default());
+            assert_err(&e, 4, field, kind, msg);
+        }
+    }
+
+    #[test]
+    fn csv_rates_declared_but_increments_written() {
+        let mut input = String::from("t,w_x,w_y,w_z,f_x,f_y,f_z\n");
+        for i in 0..100 {
+            writeln!(input, "{},0,0,0,0,0,{}", f64::from(i) * 0.005, -9.8 * 0.005).expect("String");
+        }
+        let e = read_err(&input, &ImuReadOptions::default());
+        assert_eq!(e.kind, InputErrorKind::LayoutMismatch);
+        assert_eq!(e.field.as_deref(), Some("f_x, f_y, f_z"));
+        assert!(e.message.contains("lines 2-101"), "{e}");
+    }
+
+    #[test]
+    fn text_read_as_rates() {
+        let input = "1.0 0.1 0.2 0.3 1 2 9\n1.5 0.1 0.2 0.3 1 2 9\n";
+        let options = ImuReadOptions {
+            layout: Some(ImuLayout::Rates),
+            ..text()
+        };
+        let s = read_all(input, &options).expect("good");
+        assert_eq!(s[1].dt, 0.5);
+        assert_eq!(s[1].dtheta, Vector3::new(0.05, 0.1, 0.15));
+        assert_eq!(s[1].dvel, Vector3::new(0.5, 1.0, 4.5));
+        let e = read_err("1 0 0 0 0 0 0\n2 0 0 0 0 x 0\n", &options);
+        assert_eq!(e.field.as_deref(), Some("f_y"));
+    }
+
+    #[test]
+    fn time_window() {
+        let mut input = stationary_text(1000, 100.0, 0.0, ImuLayout::Increments);
+        // Past the lookahead and before the start: only the time is looked at.
+        input = input.replacen("3.000000 ", "3.000000 garbage ", 1);
+        let window = ImuReadOptions {
+            t_start: Some(5.0),
+            t_end: Some(7.0),
+            ..text()
+        };
+        let mut r = reader(&input, &window).expect("good");
+        let s: Vec<_> = r
+            .by_ref()
+            .collect::<Result<_, _>>()
+            .expect("garbage skipped");
+        assert_eq!(s.first().map(|s| s.t), Some(5.0));
+        assert_eq!(s.last().map(|s| s.t), Some(7.0));
+        assert_eq!(s.len(), 201);
+        assert!(
+            (s[0].dt - 0.01).abs() < 1e-12,
+            "true dt from the skipped predecessor"
+        );
+        assert!(r.bytes_read() < input.len() as u64, "stops after t_end");
+        // Time is still checked before the start.
+        let backwards = input.replacen("4.000000 ", "3.500000 ", 1);
+        let e = read_err(&backwards, &window);
+        assert_err(
+            &e,
+            401,
+            Some("t"),
+            InputErrorKind::TimeNotIncreasing,
+            "t = 3.5 after t = 3.99",
+        );
+        // A bad field inside the window is still an error.
+        let bad = input.replacen("6.000000 ", "6.000000 x ", 1);
+        assert_eq!(read_err(&bad, &window).line, 601);
+        let empty = ImuReadOptions {
+            t_start: Some(50.0),
+            ..text()
+        };
+        assert_eq!(read_all(&input, &empty).map(|s| s.len()), Ok(0));
+        let inverted = ImuReadOptions {
+            t_start: Some(7.0),
+            t_end: Some(5.0),
+            ..text()
+        };
+        assert_eq!(read_err(&input, &inverted).kind, InputErrorKind::Usage);
+    }
+
+    #[test]
+    fn csv_window_skips_by_time_column() {
+        let mut input = String::from("x,t,dtheta_x,dtheta_y,dtheta_z,dvel_x,dvel_y,dvel_z\n");
+        for i in 0..400 {
+            let junk = if i == 300 { "junk" } else { "0" };
+            writeln!(input, "a,{},{junk},0,0,0,0,-0.049", f64::from(i) * 0.005).expect("String");
+        }
+        let window = ImuReadOptions {
+            t_start: Some(1.6),
+            ..ImuReadOptions::default()
+        };
+        let s = read_all(&input, &window).expect("junk before the window is not parsed");
+        assert_eq!(s.len(), 80);
+        assert_eq!(s[0].t, 1.6);
+    }
+
+    #[test]
+    fn open_reads_files_and_reports_progress() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("IMU.txt");
+        let body = stationary_text(50, 100.0, 1.0, ImuLayout::Increments);
+        std::fs::write(&path, &body).expect("write");
+        let r = ImuReader::open(&path, &ImuReadOptions::default()).expect("open");
+        let progress = r.progress();
+        assert_eq!(r.count(), 50);
+        assert_eq!(progress.bytes(), body.len() as u64);
+        let missing = dir.path().join("none.txt");
+        let e = ImuReader::open(&missing, &ImuReadOptions::default())
+            .err()
+            .expect("missing");
+        assert_eq!(e.kind, InputErrorKind::Io);
+        assert!(e.to_string().contains("none.txt: cannot open"), "{e}");
+    }
+
+    proptest! {
+        #[test]
+        fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2000)) {
+            for format in [ImuFormat::Auto, ImuFormat::KfGinsText, ImuFormat::Csv] {
+                for check_layout in [false, true] {
+                    let options = ImuReadOptions { format, check_layout, ..ImuReadOptions::default() };
+                    if let Ok(r) = ImuReader::new(&bytes[..], PATH, &options) {
+                        for s in r.flatten() {
+                            prop_assert!(s.dt > 0.0 && s.t.is_finite());
+                        }
+                    }
+                }
+            }
+        }
+
+        #[test]
+        fn near_valid_lines_never_panic(
+            lines in proptest::collection::vec(
+                proptest::collection::vec(
+                    prop_oneof![
+                        Just("1".to_owned()), Just("".to_owned()), Just("nan".to_owned()),
+                        Just(",".to_owned()), Just(" ".to_owned()), Just("t".to_owned()),
+                        Just("dvel_x".to_owned()), Just("-1e400".to_owned()),
+                        (0.0..100.0f64).prop_map(|x| x.to_string()),
+                    ],
+                    0..10,
+                ),
+                0..30,
+            ),
+            start in proptest::option::of(0.0..100.0f64),
+        ) {
+            let input: String = lines.iter().map(|l| l.join(",") + "\n").collect();
+            let options = ImuReadOptions { t_start: start, ..ImuReadOptions::default() };
+            if let Ok(r) = reader(&input, &options) {
+                for s in r.flatten() {
+                    prop_assert!(s.dt > 0.0);
+                }
+            }
+        }
+
+        #[test]
+        fn written_values_read_back_bit_exact(
+            rows in proptest::collection::vec(prop::array::uniform6(-1e3..1e3f64), 2..50),
+            comma in any::<bool>(),
+        ) {
+            let sep = if comma { "," } else { "\t" };
+            let mut input = String::new();
+            for (i, v) in rows.iter().enumerate() {
+                let fields: Vec<String> = v.iter().map(f64::to_string).collect();
+                writeln!(input, "{}{sep}{}", 1000.0 + i as f64 * 0.25, fields.join(sep))
+                    .expect("String");
+            }
+            let options = ImuReadOptions { check_layout: false, ..text() };
+            let s = read_all(&input, &options).expect("good");
+            for (sample, v) in s.iter().zip(&rows) {
+                prop_assert_eq!(sample.dtheta, Vector3::new(v[0], v[1], v[2]));
+                prop_assert_eq!(sample.dvel, Vector3::new(v[3], v[4], v[5]));
+            }
+        }
+    }
+}

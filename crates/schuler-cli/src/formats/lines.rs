@@ -1,0 +1,153 @@
+//! Line-by-line reading into one reused buffer, with a byte-progress counter and the
+//! skip rules shared by the text formats.
+
+use std::io::{BufRead, Read};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Longest line a reader accepts [bytes]: bounds memory on a file without newlines.
+pub(crate) const MAX_LINE_BYTES: u64 = 64 * 1024;
+
+/// Why [`LineReader::next_line`] failed.
+#[derive(Debug)]
+pub(crate) enum LineReadError {
+    /// The underlying reader failed.
+    Io(std::io::Error),
+    /// The line exceeds [`MAX_LINE_BYTES`].
+    TooLong,
+}
+
+/// Reads lines into one reused buffer (no allocation per line once it has grown),
+/// counting lines and bytes consumed.
+pub(crate) struct LineReader<R> {
+    inner: R,
+    buf: Vec<u8>,
+    /// 1-based number of the line in `buf` (0 before the first).
+    line_no: u64,
+    /// Bytes consumed so far, mirrored into `progress`.
+    bytes: u64,
+    progress: Arc<AtomicU64>,
+}
+
+impl<R: BufRead> LineReader<R> {
+    /// Wraps `inner`.
+    pub(crate) fn new(inner: R) -> Self {
+        Self {
+            inner,
+            buf: Vec::with_capacity(256),
+            line_no: 0,
+            bytes: 0,
+            progress: Arc::new(AtomicU64::new(0)),
+        }
+    }
+
+    /// Reads the next line; `Ok(false)` at end of input. The line's content (without
+    /// the line terminator, `\n` or `\r\n`, or a leading UTF-8 byte-order mark on line 1)
+    /// is then in [`Self::line`].
+    pub(crate) fn next_line(&mut self) -> Result<bool, LineReadError> {
+        self.buf.clear();
+        let n = (&mut self.inner)
+            .take(MAX_LINE_BYTES)
+            .read_until(b'\n', &mut self.buf)
+            .map_err(LineReadError::Io)?;
+        if n == 0 {
+            return Ok(false);
+        }
+        self.line_no += 1;
+        self.bytes += n as u64;
+        // A plain store: one writer, readers only want a recent value.
+        self.progress.store(self.bytes, Ordering::Relaxed);
+        if self.buf.last() == Some(&b'\n') {
+            self.buf.pop();
+            if self.buf.last() == Some(&b'\r') {
+                self.buf.pop();
+            }
+        } else if n as u64 == MAX_LINE_BYTES {
+            return Err(LineReadError::TooLong);
+        }
+        Ok(true)
+    }
+
+    /// The current line's content.
+    #[inline]
+    pub(crate) fn line(&self) -> &[u8] {
+        if self.line_no == 1 {
+            self.buf.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&self.buf)
+        } else {
+            &self.buf
+        }
+    }
+
+    /// 1-based number of the current line (0 before the first).
+    #[inline]
+    pub(crate) fn line_no(&self) -> u64 {
+        self.line_no
+    }
+
+    /// Bytes consumed so far.
+    #[inline]
+    pub(crate) fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// The shared counter mirroring [`Self::bytes`].
+    pub(crate) fn progress(&self) -> Arc<AtomicU64> {
+        Arc::clone(&self.progress)
+    }
+}
+
+/// Whether a space or tab.
+#[inline]
+pub(crate) fn is_blank(b: u8) -> bool {
+    b == b' ' || b == b'\t'
+}
+
+/// Whether a line carries no data: empty, only blanks, or a comment whose first
+/// non-blank byte is `#` or `%`.
+#[inline]
+pub(crate) fn is_skippable(line: &[u8]) -> bool {
+    match line.iter().find(|&&b| !is_blank(b)) {
+        None => true,
+        Some(&b) => b == b'#' || b == b'%',
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn all_lines(input: &[u8]) -> Vec<Vec<u8>> {
+        let mut r = LineReader::new(input);
+        let mut out = Vec::new();
+        while r.next_line().expect("in-memory read cannot fail") {
+            out.push(r.line().to_vec());
+        }
+        assert_eq!(r.bytes(), input.len() as u64);
+        out
+    }
+
+    #[test]
+    fn strips_terminators_and_bom() {
+        let lines = all_lines(b"\xEF\xBB\xBFa b\r\nc\n\nd");
+        assert_eq!(
+            lines,
+            vec![b"a b".to_vec(), b"c".to_vec(), b"".to_vec(), b"d".to_vec()]
+        );
+    }
+
+    #[test]
+    fn overlong_line_is_an_error_not_a_buffer_explosion() {
+        let input = vec![b'1'; (MAX_LINE_BYTES as usize) * 3];
+        let mut r = LineReader::new(&input[..]);
+        assert!(matches!(r.next_line(), Err(LineReadError::TooLong)));
+    }
+
+    #[test]
+    fn skip_rules() {
+        assert!(is_skippable(b""));
+        assert!(is_skippable(b" \t "));
+        assert!(is_skippable(b"# comment"));
+        assert!(is_skippable(b"  % matlab comment"));
+        assert!(!is_skippable(b" 1 2 3"));
+    }
+}

@@ -1,0 +1,13 @@
+//! File formats at the edge of the CLI: streaming readers that turn text logs into
+//! library types, with errors that name the file, the line and the field.
+//!
+//! Readers work on any [`std::io::BufRead`] (a file behind a 1 MiB
+//! [`std::io::BufReader`], or standard input), yield one item at a time and hold a
+//! bounded amount of memory whatever the length of the log.
+
+pub mod error;
+pub mod imu_log;
+mod lines;
+
+pub use error::InputError;
+pub use imu_log::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};

@@ -1,0 +1,251 @@
+//! Navigation-result writers: the KF-GINS text format (`nav.txt`) and our CSV
+//! (`nav.csv`), both streamed through one fixed-decimal number writer.
+//!
+//! KF-GINS navigation result, one epoch per line, space separated:
+//! `week sow lat[deg] lon[deg] h[m] vn ve vd[m/s] roll pitch yaw[deg]`. We write yaw in
+//! [0, 360) (the convention of the awesome-gins-datasets truth files) and longitude in
+//! (-180, 180].
+
+use anyhow::{Context, Result};
+use schuler::imu::ImuSample;
+use schuler::nav::NavState;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Append `x` with exactly `decimals` digits after the point (round half away from
+/// zero). Values too large for the integer path fall back to `{:.*}`.
+pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
+    const POW10: [f64; 13] = [
+        1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
+    ];
+    let scaled = (x.abs() * POW10[decimals]).round();
+    if decimals >= POW10.len() || !scaled.is_finite() || scaled >= 9.0e18 {
+        let _ = write!(out, "{x:.decimals$}");
+        return;
+    }
+    // Exact: scaled < 9e18 < 2^63, an integer-valued f64.
+    let n = scaled as u64;
+    if x.is_sign_negative() && n != 0 {
+        out.push(b'-');
+    }
+    let unit = 10u64.pow(decimals as u32);
+    let mut buf = itoa::Buffer::new();
+    out.extend_from_slice(buf.format(n / unit).as_bytes());
+    if decimals > 0 {
+        out.push(b'.');
+        let frac = buf.format(n % unit).as_bytes();
+        out.extend(std::iter::repeat_n(b'0', decimals - frac.len()));
+        out.extend_from_slice(frac);
+    }
+}
+
+/// Longitude wrapped to (-180, 180] degrees.
+fn wrap_lon_deg(lon_rad: f64) -> f64 {
+    let d = lon_rad.to_degrees();
+    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
+    if w == -180.0 { 180.0 } else { w }
+}
+
+/// One navigation epoch in output units.
+struct Row {
+    lat_deg: f64,
+    lon_deg: f64,
+    h: f64,
+    v: [f64; 3],
+    roll_deg: f64,
+    pitch_deg: f64,
+    yaw_deg: f64,
+}
+
+impl Row {
+    fn of(s: &NavState) -> Self {
+        let e = s.euler();
+        Self {
+            lat_deg: s.pos.lat.to_degrees(),
+            lon_deg: wrap_lon_deg(s.pos.lon),
+            h: s.pos.h,
+            v: [s.v_n.x, s.v_n.y, s.v_n.z],
+            roll_deg: e.roll.to_degrees(),
+            pitch_deg: e.pitch.to_degrees(),
+            yaw_deg: e.heading_0_2pi().to_degrees(),
+        }
+    }
+
+    /// Fields after the time, with `sep` between them. Decimals: 1e-11 deg (< 2 um)
+    /// for latitude and longitude, 1 um for height, 1 um/s for velocity, 1e-9 deg for
+    /// attitude: finer than any INS resolves, so files round-trip our results.
+    fn push(&self, out: &mut Vec<u8>, sep: u8) {
+        let fields: [(f64, usize); 9] = [
+            (self.lat_deg, 11),
+            (self.lon_deg, 11),
+            (self.h, 6),
+            (self.v[0], 6),
+            (self.v[1], 6),
+            (self.v[2], 6),
+            (self.roll_deg, 9),
+            (self.pitch_deg, 9),
+            (self.yaw_deg, 9),
+        ];
+        for (x, d) in fields {
+            out.push(sep);
+            push_fixed(out, x, d);
+        }
+    }
+}
+
+/// Writes `nav.txt` (KF-GINS) and `nav.csv` side by side.
+pub struct NavWriter {
+    txt: BufWriter<File>,
+    csv: BufWriter<File>,
+    txt_path: PathBuf,
+    csv_path: PathBuf,
+    week: u32,
+    line: Vec<u8>,
+    rows: u64,
+}
+
+/// Header of `nav.csv`.
+pub const CSV_HEADER: &str =
+    "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg";
+
+impl NavWriter {
+    /// Create `dir/nav.txt` and `dir/nav.csv` (the directory is created if needed).
+    pub fn create(dir: &Path, week: u32) -> Result<Self> {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let open = |name: &str| -> Result<(BufWriter<File>, PathBuf)> {
+            let p = dir.join(name);
+            let f = File::create(&p).with_context(|| format!("cannot create {}", p.display()))?;
+            Ok((BufWriter::with_capacity(1 << 20, f), p))
+        };
+        let (txt, txt_path) = open("nav.txt")?;
+        let (mut csv, csv_path) = open("nav.csv")?;
+        writeln!(csv, "{CSV_HEADER}")
+            .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        Ok(Self {
+            txt,
+            csv,
+            txt_path,
+            csv_path,
+            week,
+            line: Vec::with_capacity(256),
+            rows: 0,
+        })
+    }
+
+    /// Write one epoch to both files.
+    pub fn write(&mut self, s: &NavState) -> Result<()> {
+        let row = Row::of(s);
+        self.line.clear();
+        let mut b = itoa::Buffer::new();
+        self.line.extend_from_slice(b.format(self.week).as_bytes());
+        self.line.push(b' ');
+        push_fixed(&mut self.line, s.t, 6);
+        row.push(&mut self.line, b' ');
+        self.line.push(b'\n');
+        self.txt
+            .write_all(&self.line)
+            .with_context(|| format!("cannot write {}", self.txt_path.display()))?;
+
+        self.line.clear();
+        push_fixed(&mut self.line, s.t, 6);
+        row.push(&mut self.line, b',');
+        self.line.push(b'\n');
+        self.csv
+            .write_all(&self.line)
+            .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Flush both files; returns the number of epochs written.
+    pub fn finish(mut self) -> Result<u64> {
+        self.txt
+            .flush()
+            .with_context(|| format!("cannot write {}", self.txt_path.display()))?;
+        self.csv
+            .flush()
+            .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
+        Ok(self.rows)
+    }
+}
+
+/// Write states as a KF-GINS navigation text file (week 0), e.g. a simulation's truth.
+pub fn write_truth_text(path: &Path, states: impl Iterator<Item = NavState>) -> Result<()> {
+    let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut w = BufWriter::with_capacity(1 << 20, f);
+    let mut line = Vec::with_capacity(256);
+    for s in states {
+        line.clear();
+        line.extend_from_slice(b"0 ");
+        push_fixed(&mut line, s.t, 6);
+        Row::of(&s).push(&mut line, b' ');
+        line.push(b'\n');
+        w.write_all(&line)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    w.flush()
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Write samples as a KF-GINS IMU text file: `t dtheta_xyz dvel_xyz`, time to 1e-9 s
+/// and increments with 16 significant digits (round-trip exact for f64).
+pub fn write_imu_text(path: &Path, samples: impl Iterator<Item = ImuSample>) -> Result<()> {
+    let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut w = BufWriter::with_capacity(1 << 20, f);
+    for s in samples {
+        let (a, v) = (s.dtheta, s.dvel);
+        writeln!(
+            w,
+            "{:.9} {:.16e} {:.16e} {:.16e} {:.16e} {:.16e} {:.16e}",
+            s.t, a.x, a.y, a.z, v.x, v.y, v.z
+        )
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    w.flush()
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn fixed(x: f64, d: usize) -> String {
+        let mut v = Vec::new();
+        push_fixed(&mut v, x, d);
+        String::from_utf8(v).expect("ascii")
+    }
+
+    #[test]
+    fn fixed_examples() {
+        assert_eq!(fixed(45.07123456789, 11), "45.07123456789");
+        assert_eq!(fixed(-0.0000004, 6), "0.000000");
+        assert_eq!(fixed(-1.5, 0), "-2");
+        assert_eq!(fixed(-12.25, 1), "-12.3");
+        assert_eq!(fixed(0.000123, 6), "0.000123");
+        assert_eq!(fixed(1e300, 3), format!("{:.3}", 1e300));
+        assert_eq!(fixed(f64::NAN, 3), "NaN");
+    }
+
+    #[test]
+    fn longitude_wraps() {
+        assert!((wrap_lon_deg(190f64.to_radians()) + 170.0).abs() < 1e-12);
+        assert!((wrap_lon_deg(-190f64.to_radians()) - 170.0).abs() < 1e-12);
+        assert_eq!(wrap_lon_deg(180f64.to_radians()), 180.0);
+        assert_eq!(wrap_lon_deg(-180f64.to_radians()), 180.0);
+    }
+
+    proptest! {
+        /// Same digits as std's `{:.6}` (which rounds half to even on the exact
+        /// binary value) except possibly in the last digit on exact ties.
+        #[test]
+        fn fixed_agrees_with_std(x in -1e6..1e6f64) {
+            let ours: f64 = fixed(x, 6).parse().expect("number");
+            let std: f64 = format!("{x:.6}").parse().expect("number");
+            prop_assert!((ours - std).abs() <= 1.000001e-6);
+            prop_assert!((ours - x).abs() <= 0.5000001e-6);
+        }
+    }
+}
