@@ -1,9 +1,5 @@
 //! `schuler`: the command-line tool of the schuler inertial navigation toolkit.
 
-mod commands;
-mod formats;
-mod output;
-
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -20,16 +16,16 @@ struct Cli {
 #[allow(clippy::large_enum_variant)] // parsed once per run
 enum Command {
     /// Free-inertial navigation of an IMU log (KF-GINS text or CSV).
-    Nav(commands::nav::NavArgs),
+    Nav(schuler_cli::commands::nav::NavArgs),
     /// A first end-to-end run on built-in simulated data.
-    Demo(commands::demo::DemoArgs),
+    Demo(schuler_cli::commands::demo::DemoArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Nav(args) => commands::nav::run(args),
-        Command::Demo(args) => commands::demo::run(args),
+        Command::Nav(args) => schuler_cli::commands::nav::run(args),
+        Command::Demo(args) => schuler_cli::commands::demo::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -190,15 +190,21 @@ pub fn write_truth_text(path: &Path, states: impl Iterator<Item = NavState>) -> 
 }
 
 /// Write samples as a KF-GINS IMU text file: `t dtheta_xyz dvel_xyz`, time to 1e-9 s
-/// and increments with 16 significant digits (round-trip exact for f64).
-pub fn write_imu_text(path: &Path, samples: impl Iterator<Item = ImuSample>) -> Result<()> {
+/// and increments in exponent notation with `digits` significant digits (17 round-trip
+/// every f64 exactly; KF-GINS data sets carry about 13).
+pub fn write_imu_text(
+    path: &Path,
+    samples: impl Iterator<Item = ImuSample>,
+    digits: usize,
+) -> Result<()> {
+    let p = digits.clamp(1, 17) - 1;
     let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut w = BufWriter::with_capacity(1 << 20, f);
     for s in samples {
         let (a, v) = (s.dtheta, s.dvel);
         writeln!(
             w,
-            "{:.9} {:.16e} {:.16e} {:.16e} {:.16e} {:.16e} {:.16e}",
+            "{:.9} {:.p$e} {:.p$e} {:.p$e} {:.p$e} {:.p$e} {:.p$e}",
             s.t, a.x, a.y, a.z, v.x, v.y, v.z
         )
         .with_context(|| format!("cannot write {}", path.display()))?;

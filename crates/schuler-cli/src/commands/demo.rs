@@ -104,7 +104,7 @@ fn run_case<E: EarthModel, T: Trajectory>(
     let imu_path = case_dir.join("imu.txt");
     // Sample 0 ends at t = 0 and carries the initial state; samples 1..=n follow.
     let samples = analytic::samples(&earth, traj, -dt, dt, n + 1).map(&corrupt);
-    write_imu_text(&imu_path, samples)?;
+    write_imu_text(&imu_path, samples, 17)?;
     let truth_epochs = (0..=n)
         .step_by(10)
         .map(|k| analytic::state(&earth, traj, k as f64 * dt));

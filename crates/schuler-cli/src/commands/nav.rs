@@ -389,9 +389,12 @@ pub fn run(args: NavArgs) -> Result<()> {
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
-        "{}: {:?}, {}, nominal rate {:.6} Hz",
+        "{}: {}, {}, nominal rate {:.6} Hz",
         settings.imu.display(),
-        reader.format(),
+        match reader.format() {
+            ImuFormat::Csv => "CSV",
+            _ => "KF-GINS text",
+        },
         reader.layout(),
         1.0 / reader.nominal_dt()
     );

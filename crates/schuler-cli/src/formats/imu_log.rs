@@ -1000,8 +1000,8 @@ impl<R: BufRead> ImuReader<R> {
                 "lines {first_line}-{last_line} look like {looks_like}, not {declared}: read as \
                  {declared} their median specific force is {declared_g:.3} g, read as \
                  {looks_like} {other_g:.3} g (g = {STANDARD_GRAVITY} m/s^2; plausible \
-                 {}-{} g); read the file as {looks_like} (ImuLayout::{looks_like:?}) or turn \
-                 the layout check off",
+                 {}-{} g); read the file as {looks_like} (--imu-layout {looks_like}) or \
+                 turn this check off (--no-layout-check)",
                 PLAUSIBLE_SPECIFIC_FORCE_G.0, PLAUSIBLE_SPECIFIC_FORCE_G.1
             ),
         ))
@@ -1418,7 +1418,7 @@ mod tests {
                 .contains("lines 1-201 look like rates, not increments"),
             "{e}"
         );
-        assert!(e.message.contains("ImuLayout::Rates"), "{e}");
+        assert!(e.message.contains("--imu-layout rates"), "{e}");
         // Read as declared rates, the same file is fine and converts to increments.
         let as_rates = ImuReadOptions {
             layout: Some(ImuLayout::Rates),

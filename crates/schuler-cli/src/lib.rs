@@ -1,0 +1,6 @@
+//! The `schuler` command-line tool as a library: file formats, writers and the
+//! commands, so that tests and benchmarks drive exactly what the binary runs.
+
+pub mod commands;
+pub mod formats;
+pub mod output;

@@ -1,0 +1,146 @@
+//! Free-inertial navigation of the drive9min data set against its truth: a 530-s car
+//! drive made by gnss-ins-sim (not by schuler), with KF-GINS's published figures on the
+//! same data (`../shared/data/drive9min/README.md`).
+
+use schuler::earth::{EarthModel, Geodetic, Wgs84};
+use schuler::rotation::Euler;
+use schuler_cli::commands::nav::{EarthChoice, NavSettings, navigate};
+use schuler_cli::formats::{ImuReadOptions, ImuReader};
+use schuler_cli::output::NavWriter;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+fn data_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/drive9min");
+    assert!(
+        dir.is_dir(),
+        "{} is missing: the shared data sets live beside the checkout",
+        dir.display()
+    );
+    dir
+}
+
+/// Decompress `name.xz` from the data set into `dir/name`.
+fn unpack(dir: &Path, name: &str) -> PathBuf {
+    let src = data_dir().join(format!("{name}.xz"));
+    let mut input = std::io::BufReader::new(std::fs::File::open(&src).expect("open .xz"));
+    let mut out = Vec::new();
+    lzma_rs::xz_decompress(&mut input, &mut out).expect("xz");
+    let dst = dir.join(name);
+    std::fs::write(&dst, out).expect("write");
+    dst
+}
+
+/// Horizontal RMS and max, vertical max [m], and the largest roll/pitch/yaw error
+/// [deg] of `nav.txt` against `truth.nav`, matched by time (both at 100 Hz).
+struct Errors {
+    horizontal_rms: f64,
+    horizontal_max: f64,
+    vertical_max: f64,
+    attitude_max_deg: f64,
+    epochs: usize,
+}
+
+fn parse_rows(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .expect("read")
+        .lines()
+        .map(|l| {
+            l.split_whitespace()
+                .map(|x| x.parse().expect("number"))
+                .collect()
+        })
+        .collect()
+}
+
+fn errors(nav: &Path, truth: &Path) -> Errors {
+    let truth_rows = parse_rows(truth);
+    let by_time: HashMap<i64, &Vec<f64>> = truth_rows
+        .iter()
+        .map(|r| ((r[1] * 100.0).round() as i64, r))
+        .collect();
+    let (mut sum2, mut hmax, mut vmax, mut amax, mut n) = (0.0, 0.0f64, 0.0f64, 0.0f64, 0);
+    for r in parse_rows(nav) {
+        let t = by_time[&((r[1] * 100.0).round() as i64)];
+        let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
+        let radii = Wgs84.radii(truth.lat);
+        let dn = (r[2] - t[2]).to_radians() * (radii.meridian + truth.h);
+        let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
+        let h = dn.hypot(de);
+        sum2 += h * h;
+        hmax = hmax.max(h);
+        vmax = vmax.max((r[4] - t[4]).abs());
+        let q = Euler::from_degrees(r[8], r[9], r[10]).to_quaternion();
+        let qt = Euler::from_degrees(t[8], t[9], t[10]).to_quaternion();
+        amax = amax.max(q.angle_to(&qt).to_degrees());
+        n += 1;
+    }
+    Errors {
+        horizontal_rms: (sum2 / n as f64).sqrt(),
+        horizontal_max: hmax,
+        vertical_max: vmax,
+        attitude_max_deg: amax,
+        epochs: n,
+    }
+}
+
+/// Navigate `imu` from t = 1.0 s with the truth's initial state (the README's KF-GINS
+/// set-up), every epoch written.
+fn run(dir: &Path, imu: PathBuf) -> Errors {
+    let settings = NavSettings {
+        imu,
+        read: ImuReadOptions {
+            t_start: Some(1.0),
+            ..ImuReadOptions::default()
+        },
+        init_pos: Geodetic::from_degrees(45.0712345678, 7.6812345678, 245.0),
+        init_vel: nalgebra::Vector3::zeros(),
+        init_att: Euler::from_degrees(0.0, 0.0, 10.0),
+        output_rate: None,
+        out: dir.join("out"),
+        earth: EarthChoice::Wgs84,
+        week: 0,
+    };
+    let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
+    let writer = NavWriter::create(&settings.out, 0).expect("writer");
+    navigate(Wgs84, &settings, &mut reader, writer, |_| {}).expect("navigate");
+    errors(&dir.join("out/nav.txt"), &unpack(dir, "truth.nav"))
+}
+
+/// Error-free increments: the remaining error is the generator's own (forward-Euler
+/// truth, start-of-interval rates; the data set's README). KF-GINS gets 0.14 / 0.29 m
+/// horizontal RMS / max and 0.22 m vertical; we must do no worse than those printed
+/// figures rounded up in their last digit (measured: 0.139 / 0.292 m, 0.006 m).
+#[test]
+fn error_free_imu_matches_the_generator_floor() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = unpack(dir.path(), "IMU_true.txt");
+    let e = run(dir.path(), imu);
+    eprintln!(
+        "IMU_true: horizontal RMS {:.3} max {:.3} m, vertical max {:.3} m, attitude max {:.5} deg, {} epochs",
+        e.horizontal_rms, e.horizontal_max, e.vertical_max, e.attitude_max_deg, e.epochs
+    );
+    assert_eq!(e.epochs, 52_900);
+    assert!(e.horizontal_rms <= 0.15);
+    assert!(e.horizontal_max <= 0.30);
+    assert!(e.vertical_max <= 0.22);
+    assert!(e.attitude_max_deg < 0.001);
+}
+
+/// With the simulated sensor errors the drift is the deterministic response to the
+/// biases, which any correct mechanization reproduces: KF-GINS prints 348 / 798 m
+/// horizontal RMS / max and 194 m vertical; we agree within 1 % (its figures carry
+/// three digits; measured here 348.4 / 797.9 / 194.3 m).
+#[test]
+fn erroneous_imu_drifts_as_kf_gins_does() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = unpack(dir.path(), "IMU.txt");
+    let e = run(dir.path(), imu);
+    eprintln!(
+        "IMU: horizontal RMS {:.1} max {:.1} m, vertical max {:.1} m",
+        e.horizontal_rms, e.horizontal_max, e.vertical_max
+    );
+    assert!((e.horizontal_rms / 348.0 - 1.0).abs() < 0.01);
+    assert!((e.horizontal_max / 798.0 - 1.0).abs() < 0.01);
+    assert!((e.vertical_max / 194.0 - 1.0).abs() < 0.01);
+}
