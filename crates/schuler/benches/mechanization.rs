@@ -4,13 +4,22 @@
 //! 200 Hz, so the timing is the mechanization alone.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use schuler::earth::{Geodetic, Sphere, Wgs84};
+use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
 use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, Mechanization};
+use schuler::nav::{LocalLevel, Mechanization, NavState};
 use schuler::sim::analytic::{self, Maneuvering};
 use std::hint::black_box;
 
 const N: usize = 20_000;
+
+/// Steps a fresh mechanization over all samples.
+fn step_all<E: EarthModel>(earth: E, start: NavState, samples: &[ImuSample]) -> NavState {
+    let mut nav = LocalLevel::new(earth, start);
+    for s in samples {
+        nav.step(black_box(s));
+    }
+    nav.state()
+}
 
 fn bench_local_level(c: &mut Criterion) {
     let traj = Maneuvering::flight(Geodetic::from_degrees(30.5, 114.3, 500.0));
@@ -19,23 +28,11 @@ fn bench_local_level(c: &mut Criterion) {
     let mut group = c.benchmark_group("mechanization");
     group.throughput(Throughput::Elements(N as u64));
     group.bench_function("local_level_wgs84", |b| {
-        b.iter(|| {
-            let mut nav = LocalLevel::new(Wgs84, start);
-            for s in &samples {
-                nav.step(black_box(s));
-            }
-            black_box(nav.state())
-        })
+        b.iter(|| black_box(step_all(Wgs84, start, &samples)))
     });
     let sphere = Sphere::textbook(true);
     group.bench_function("local_level_sphere", |b| {
-        b.iter(|| {
-            let mut nav = LocalLevel::new(sphere, start);
-            for s in &samples {
-                nav.step(black_box(s));
-            }
-            black_box(nav.state())
-        })
+        b.iter(|| black_box(step_all(sphere, start, &samples)))
     });
     group.finish();
 }

@@ -123,28 +123,6 @@ fn maneuvering_thirty_minutes_within_half_metre() {
     );
 }
 
-/// Attitude error after `seconds` of classical coning sampled at 200 Hz.
-fn coning_error(corrections: Corrections) -> f64 {
-    let traj = Coning {
-        pos: Geodetic::from_degrees(45.0, 0.0, 0.0),
-        half_angle: 1f64.to_radians(),
-        rate: std::f64::consts::TAU * 10.0,
-    };
-    let sphere = Sphere::textbook(false);
-    let final_state = run(
-        sphere,
-        &traj,
-        1.0 / 200.0,
-        2000,
-        corrections,
-        usize::MAX,
-        |_, _| {},
-    );
-    final_state
-        .q_bn
-        .angle_to(&analytic::state(&sphere, &traj, 10.0).q_bn)
-}
-
 /// Ratio of the uncorrected to the corrected per-step error of the previous-sample
 /// two-sample correction under classical coning (or sculling), at `l = Omega dt`.
 /// Averaged over phase, the exact second-order term per step is `1/2 (l - sin l)` and
@@ -157,64 +135,74 @@ fn two_sample_ratio(l: f64) -> f64 {
     exact / (exact - 2.0 / 3.0 * (0.5 * l).sin().powi(2) * l.sin())
 }
 
-/// Classical coning at 10 Hz sampled at 200 Hz: the coning correction reduces the
-/// attitude error at least 50-fold (the issue), and by the closed-form ratio within 1 %
-/// (the residual 1 % is the cone angle's higher-order terms, O(alpha^2) = 3e-4, and the
-/// 10-s window's end phase).
-#[test]
-fn coning_correction_reduces_attitude_error_fifty_fold() {
-    let with = coning_error(Corrections::default());
-    let without = coning_error(Corrections {
-        coning: false,
-        sculling: true,
-    });
+/// Runs 10 s of `traj` at 200 Hz on the non-rotating sphere with all corrections and
+/// with `without` switched off, measures `error(nav, truth)` at the end of each, and
+/// checks the ratio is at least 50 (the issue) and the closed form within 1 % (the
+/// residual is the motion's higher-order terms, O(amplitude^2) ~ 3e-4, and the
+/// window's end phase).
+fn check_correction_ratio<T: Trajectory>(
+    name: &str,
+    traj: &T,
+    without: Corrections,
+    error: impl Fn(&NavState, &NavState) -> f64,
+) {
+    let sphere = Sphere::textbook(false);
+    let truth = analytic::state(&sphere, traj, 10.0);
+    let final_error = |c| {
+        error(
+            &run(sphere, traj, 1.0 / 200.0, 2000, c, usize::MAX, |_, _| {}),
+            &truth,
+        )
+    };
+    let (with, without) = (final_error(Corrections::default()), final_error(without));
     let theory = two_sample_ratio(std::f64::consts::TAU * 10.0 / 200.0);
+    let ratio = without / with;
     eprintln!(
-        "coning: with {with:.3e} rad, without {without:.3e} rad, ratio {:.2}, theory {theory:.2}",
-        without / with
+        "{name}: with {with:.3e}, without {without:.3e}, ratio {ratio:.2}, theory {theory:.2}"
     );
-    assert!(without / with >= 50.0, "ratio {}", without / with);
-    assert!((without / with / theory - 1.0).abs() < 0.01);
+    assert!(ratio >= 50.0, "{name} ratio {ratio}");
+    assert!(
+        (ratio / theory - 1.0).abs() < 0.01,
+        "{name} ratio {ratio}, theory {theory}"
+    );
 }
 
-/// Velocity error after 10 s of classical sculling at 10 Hz sampled at 200 Hz.
-fn sculling_error(corrections: Corrections) -> f64 {
+/// Classical coning (1 deg half-angle) at 10 Hz sampled at 200 Hz: the coning
+/// correction reduces the attitude error at least 50-fold.
+#[test]
+fn coning_correction_reduces_attitude_error_fifty_fold() {
+    let traj = Coning {
+        pos: Geodetic::from_degrees(45.0, 0.0, 0.0),
+        half_angle: 1f64.to_radians(),
+        rate: std::f64::consts::TAU * 10.0,
+    };
+    let without = Corrections {
+        coning: false,
+        sculling: true,
+    };
+    check_correction_ratio("coning [rad]", &traj, without, |nav, truth| {
+        nav.q_bn.angle_to(&truth.q_bn)
+    });
+}
+
+/// Classical sculling at 10 Hz sampled at 200 Hz: the sculling correction reduces the
+/// rectified velocity error at least 50-fold, by the same closed-form ratio as coning
+/// (sculling is coning's dual: Savage 1998, table 1).
+#[test]
+fn sculling_correction_reduces_velocity_error_fifty_fold() {
     let traj = Sculling {
         pos: Geodetic::from_degrees(45.0, 0.0, 0.0),
         roll_amplitude: 1f64.to_radians(),
         east_amplitude: 0.01,
         rate: std::f64::consts::TAU * 10.0,
     };
-    let sphere = Sphere::textbook(false);
-    let final_state = run(
-        sphere,
-        &traj,
-        1.0 / 200.0,
-        2000,
-        corrections,
-        usize::MAX,
-        |_, _| {},
-    );
-    (final_state.v_n - analytic::state(&sphere, &traj, 10.0).v_n).norm()
-}
-
-/// Classical sculling at 10 Hz sampled at 200 Hz: the sculling correction reduces the
-/// rectified velocity error at least 50-fold, and by the same closed-form ratio as
-/// coning within 1 % (sculling is coning's dual: Savage 1998, table 1).
-#[test]
-fn sculling_correction_reduces_velocity_error_fifty_fold() {
-    let with = sculling_error(Corrections::default());
-    let without = sculling_error(Corrections {
+    let without = Corrections {
         coning: true,
         sculling: false,
+    };
+    check_correction_ratio("sculling [m/s]", &traj, without, |nav, truth| {
+        (nav.v_n - truth.v_n).norm()
     });
-    let theory = two_sample_ratio(std::f64::consts::TAU * 10.0 / 200.0);
-    eprintln!(
-        "sculling: with {with:.3e} m/s, without {without:.3e} m/s, ratio {:.2}, theory {theory:.2}",
-        without / with
-    );
-    assert!(without / with >= 50.0, "ratio {}", without / with);
-    assert!((without / with / theory - 1.0).abs() < 0.01);
 }
 
 /// The textbook's Schuler period: on the non-rotating sphere (a = 6371 km,
