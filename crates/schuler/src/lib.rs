@@ -10,3 +10,4 @@ pub mod imu;
 pub mod nav;
 pub mod rotation;
 pub mod sim;
+pub mod units;
