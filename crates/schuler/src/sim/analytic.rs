@@ -21,11 +21,43 @@ use crate::nav::NavState;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// A smooth trajectory: position and attitude as formulas in time.
+///
+/// Trajectories are written either in geodetic terms (`position`, `c_bn`) or, where
+/// latitude and longitude are singular (over a pole), directly in ECEF by overriding
+/// [`Trajectory::ecef_pose`]; the kinematics use only the ECEF pose.
 pub trait Trajectory {
     /// Latitude [rad], longitude [rad], height [m] at time `t`.
     fn position(&self, t: Jet) -> JetVec3;
     /// Body-to-NED DCM `c_bn` at time `t`.
     fn c_bn(&self, t: Jet) -> JetMat3;
+    /// ECEF position `r_e` [m] and body-to-ECEF DCM `c_be` at time `t`; by default
+    /// from the geodetic position and `c_be = c_ne c_bn`.
+    fn ecef_pose<E: EarthModel>(&self, earth: &E, t: Jet) -> (JetVec3, JetMat3) {
+        let p = self.position(t);
+        let r_e = geodetic_to_ecef_jet(earth, &p);
+        (r_e, c_ne_jet(p[0], p[1]).mul(&self.c_bn(t)))
+    }
+}
+
+/// The truth in ECEF at one instant, defined everywhere (poles included).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EcefTruth {
+    /// Position [m].
+    pub r_e: Vector3<f64>,
+    /// Velocity relative to the Earth [m/s].
+    pub v_e: Vector3<f64>,
+    /// Body-to-ECEF DCM.
+    pub c_be: nalgebra::Matrix3<f64>,
+}
+
+/// True ECEF position, velocity and attitude at time `t`.
+pub fn ecef_truth<E: EarthModel, T: Trajectory + ?Sized>(earth: &E, traj: &T, t: f64) -> EcefTruth {
+    let (r_e, c_be) = traj.ecef_pose(earth, Jet::variable(t));
+    EcefTruth {
+        r_e: jet::value(&r_e),
+        v_e: jet::derivative(&r_e),
+        c_be: c_be.value(),
+    }
 }
 
 /// True angular rate and specific force at one instant, body axes FRD.
@@ -70,11 +102,7 @@ pub fn kinematics<E: EarthModel, T: Trajectory + ?Sized>(
     traj: &T,
     t: f64,
 ) -> Kinematics {
-    let tj = Jet::variable(t);
-    let p = traj.position(tj);
-    let r_e = geodetic_to_ecef_jet(earth, &p);
-    let c_ne = c_ne_jet(p[0], p[1]);
-    let c_be = c_ne.mul(&traj.c_bn(tj));
+    let (r_e, c_be) = traj.ecef_pose(earth, Jet::variable(t));
     let c_be_v = c_be.value();
     let c_eb = c_be_v.transpose();
     let s = c_eb * c_be.derivative();
@@ -87,7 +115,10 @@ pub fn kinematics<E: EarthModel, T: Trajectory + ?Sized>(
     let w_ib_b = c_eb * w_ie_e + w_eb_b;
     let v_e = jet::derivative(&r_e);
     let a_e = jet::second_derivative(&r_e);
-    let g_e = c_ne.value() * earth.gravity_n(p[0].v, p[2].v);
+    // Gravity along the local normal: north/east are arbitrary exactly at a pole,
+    // where the normal-gravity field has no horizontal component.
+    let pos = earth.ecef_to_geodetic(&jet::value(&r_e));
+    let g_e = crate::earth::c_ne(pos.lat, pos.lon) * earth.gravity_n(pos.lat, pos.h);
     let f_e = a_e + 2.0 * w_ie_e.cross(&v_e) - g_e;
     Kinematics {
         w_ib_b,
