@@ -2,4 +2,5 @@
 
 pub mod analytic;
 pub mod jet;
+pub mod motion;
 pub mod spline;
