@@ -3,4 +3,5 @@
 pub mod analytic;
 pub mod jet;
 pub mod motion;
+pub mod scenario;
 pub mod spline;

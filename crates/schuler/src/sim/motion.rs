@@ -221,11 +221,105 @@ pub enum MotionError {
     Empty,
 }
 
-/// The state at the end of a list of pieces, and the knots along them.
+/// Integrates pieces one after another, so a maneuver can be planned from the state
+/// the previous ones reached (current speed, height, bank).
+#[derive(Debug, Clone)]
+pub struct MotionBuilder<E: EarthModel> {
+    earth: E,
+    x: [f64; 9],
+    t: f64,
+    knots: Vec<Knot>,
+    pieces: usize,
+}
+
+impl<E: EarthModel> MotionBuilder<E> {
+    /// Start at `start`.
+    pub fn new(earth: E, start: &Start) -> Self {
+        let e = start.attitude;
+        let x = [
+            start.pos.lat,
+            start.pos.lon,
+            start.pos.h,
+            e.roll,
+            e.pitch,
+            e.yaw,
+            start.v_n.x,
+            start.v_n.y,
+            start.v_n.z,
+        ];
+        Self {
+            earth,
+            x,
+            t: start.t,
+            knots: Vec::new(),
+            pieces: 0,
+        }
+    }
+
+    /// The current state (end of the pieces pushed so far).
+    pub fn state(&self) -> Start {
+        let x = &self.x;
+        Start {
+            t: self.t,
+            pos: Geodetic::new(x[0], x[1], x[2]),
+            v_n: Vector3::new(x[6], x[7], x[8]),
+            attitude: Euler::new(x[3], x[4], x[5]),
+        }
+    }
+
+    /// Integrate one piece.
+    pub fn push(&mut self, piece: &Piece) -> Result<(), MotionError> {
+        let index = self.pieces;
+        if !(piece.duration.is_finite() && piece.duration > 0.0) {
+            return Err(MotionError::BadDuration {
+                index,
+                duration: piece.duration,
+            });
+        }
+        let n = (piece.duration / MAX_STEP).ceil().max(1.0) as usize;
+        let h = piece.duration / n as f64;
+        let mut x = self.x;
+        let mut knots = Vec::with_capacity(n + 1);
+        if self.knots.is_empty() {
+            knots.push(knot(&self.earth, piece, self.t, 0.0, &x));
+        }
+        for k in 0..n {
+            x = rk4_step(&self.earth, piece, k as f64 * h, h, &x);
+            let ok = x.iter().all(|v| v.is_finite()) && x[0].abs() < 89.9f64.to_radians();
+            if !ok {
+                return Err(MotionError::OutOfDomain {
+                    index,
+                    lat_deg: x[0].to_degrees(),
+                });
+            }
+            let tau1 = (k + 1) as f64 * h;
+            knots.push(knot(&self.earth, piece, self.t + tau1, tau1, &x));
+        }
+        self.knots.extend(knots);
+        self.x = x;
+        self.t += piece.duration;
+        self.pieces += 1;
+        Ok(())
+    }
+
+    /// The trajectory through everything pushed.
+    pub fn finish(self) -> Result<SplineTrajectory, MotionError> {
+        if self.pieces == 0 {
+            return Err(MotionError::Empty);
+        }
+        let lat_deg = self.x[0].to_degrees();
+        SplineTrajectory::new(self.knots).map_err(|_| MotionError::OutOfDomain {
+            index: self.pieces - 1,
+            lat_deg,
+        })
+    }
+}
+
+/// The trajectory of `pieces` from `start`, and the state at its end.
 pub struct Generated {
     /// The trajectory.
     pub trajectory: SplineTrajectory,
-    /// State at the end: position, NED velocity, attitude.
+    /// State at the end.
     pub end: Start,
 }
 
@@ -235,59 +329,14 @@ pub fn generate<E: EarthModel>(
     start: &Start,
     pieces: &[Piece],
 ) -> Result<Generated, MotionError> {
-    if pieces.is_empty() {
-        return Err(MotionError::Empty);
+    let mut b = MotionBuilder::new(*earth, start);
+    for p in pieces {
+        b.push(p)?;
     }
-    let e = start.attitude;
-    let mut x = [
-        start.pos.lat,
-        start.pos.lon,
-        start.pos.h,
-        e.roll,
-        e.pitch,
-        e.yaw,
-        start.v_n.x,
-        start.v_n.y,
-        start.v_n.z,
-    ];
-    let mut t = start.t;
-    let mut knots = vec![knot(earth, &pieces[0], t, 0.0, &x)];
-    for (index, piece) in pieces.iter().enumerate() {
-        if !(piece.duration.is_finite() && piece.duration > 0.0) {
-            return Err(MotionError::BadDuration {
-                index,
-                duration: piece.duration,
-            });
-        }
-        let n = (piece.duration / MAX_STEP).ceil().max(1.0) as usize;
-        let h = piece.duration / n as f64;
-        for k in 0..n {
-            let tau = k as f64 * h;
-            x = rk4_step(earth, piece, tau, h, &x);
-            let ok = x.iter().all(|v| v.is_finite()) && x[0].abs() < 89.9f64.to_radians();
-            if !ok {
-                return Err(MotionError::OutOfDomain {
-                    index,
-                    lat_deg: x[0].to_degrees(),
-                });
-            }
-            let tau1 = (k + 1) as f64 * h;
-            knots.push(knot(earth, piece, t + tau1, tau1, &x));
-        }
-        t += piece.duration;
-    }
-    let trajectory = SplineTrajectory::new(knots).map_err(|_| MotionError::OutOfDomain {
-        index: pieces.len() - 1,
-        lat_deg: x[0].to_degrees(),
-    })?;
+    let end = b.state();
     Ok(Generated {
-        trajectory,
-        end: Start {
-            t,
-            pos: Geodetic::new(x[0], x[1], x[2]),
-            v_n: Vector3::new(x[6], x[7], x[8]),
-            attitude: Euler::new(x[3], x[4], x[5]),
-        },
+        trajectory: b.finish()?,
+        end,
     })
 }
 
