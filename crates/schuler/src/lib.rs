@@ -5,6 +5,7 @@
 //! (NED); DCMs are named `c_xy` for the transformation from frame `x` to frame `y`
 //! (`v_n = c_bn * v_b`).
 
+pub mod analysis;
 pub mod earth;
 pub mod imu;
 pub mod nav;

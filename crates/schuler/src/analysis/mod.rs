@@ -1,0 +1,3 @@
+//! Error statistics and sensor characterization.
+
+pub mod allan;

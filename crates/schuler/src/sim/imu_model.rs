@@ -1,0 +1,276 @@
+//! IMU sensor error model: what a real gyro and accelerometer triad add to the exact
+//! increments.
+//!
+//! Per triad (SI: gyro in rad/s, accelerometer in m/s^2), over one interval `dt`:
+//!
+//! `y = (I + diag(s) + diag(a) sign(x) + M) x + (b + b_on + b_gm + b_rw) dt + n + G dv + vib`
+//!
+//! - `b`: constant bias; `b_on`: turn-on bias, drawn once per run with std `turn_on`;
+//! - `b_gm`: first-order Gauss–Markov bias instability, `b_k = e^{-dt/τ} b_{k-1} +
+//!   σ sqrt(1 - e^{-2dt/τ}) w` (stationary std `σ`, correlation time `τ`);
+//! - `b_rw`: rate (or acceleration) random walk, `b_rw += K sqrt(dt) w`;
+//! - `n`: angle (velocity) random walk: white rate noise of density `N`, an increment
+//!   noise of std `N sqrt(dt)` (IEEE Std 952-1997 annex C);
+//! - `s`, `a`: scale-factor error and its asymmetry (`a` times the sign of the input);
+//! - `M`: misalignment and non-orthogonality (off-diagonal, rad);
+//! - `G dv`: gyro g-sensitivity, rad/s per m/s^2 times the true velocity increment;
+//! - `vib`: accelerometer vibration lines `A sin(2π f t + φ)` integrated exactly;
+//! - quantization to a step `q` with the residual carried to the next sample, so the
+//!   sum of the outputs never drifts from the sum of the inputs by more than `q`.
+
+use super::random::Noise;
+use crate::imu::ImuSample;
+use nalgebra::{Matrix3, Vector3};
+
+/// One sinusoidal vibration line on the accelerometers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VibrationLine {
+    /// Frequency [Hz].
+    pub freq_hz: f64,
+    /// Amplitude per axis [m/s^2].
+    pub amplitude: Vector3<f64>,
+    /// Phase [rad].
+    pub phase: f64,
+}
+
+/// Error parameters of one triad (all per axis, SI).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TriadModel {
+    /// Constant bias.
+    pub bias: Vector3<f64>,
+    /// Standard deviation of the turn-on bias (random per run).
+    pub turn_on: Vector3<f64>,
+    /// Gauss–Markov bias instability: stationary standard deviation.
+    pub gm_sigma: Vector3<f64>,
+    /// Gauss–Markov correlation time [s] (> 0 where `gm_sigma` > 0).
+    pub gm_tau: Vector3<f64>,
+    /// White-noise density (ARW [rad/sqrt(s)] or VRW [m/s/sqrt(s)]).
+    pub white: Vector3<f64>,
+    /// Random-walk rate of the bias [unit/sqrt(s)].
+    pub random_walk: Vector3<f64>,
+    /// Scale-factor error (dimensionless).
+    pub scale: Vector3<f64>,
+    /// Scale-factor asymmetry (dimensionless).
+    pub asymmetry: Vector3<f64>,
+    /// Misalignment / non-orthogonality (diagonal ignored) [rad].
+    pub misalignment: Matrix3<f64>,
+    /// Quantization step of the increments (0: none) [rad or m/s].
+    pub quantum: Vector3<f64>,
+}
+
+/// The whole IMU's error parameters.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ImuModel {
+    /// Gyro triad.
+    pub gyro: TriadModel,
+    /// Accelerometer triad.
+    pub accel: TriadModel,
+    /// Gyro g-sensitivity [rad/s per m/s^2].
+    pub g_sensitivity: Matrix3<f64>,
+    /// Accelerometer vibration lines.
+    pub vibration: Vec<VibrationLine>,
+}
+
+/// Running state of one triad's random processes.
+#[derive(Debug)]
+struct TriadState {
+    turn_on: Vector3<f64>,
+    gm: Vector3<f64>,
+    rw: Vector3<f64>,
+    carry: Vector3<f64>,
+}
+
+/// A seeded simulation of an [`ImuModel`], applied sample after sample.
+#[derive(Debug)]
+pub struct ImuSimulator {
+    model: ImuModel,
+    gyro: TriadState,
+    accel: TriadState,
+    noise: Noise,
+}
+
+/// Stream ids of the random draws, fixed so adding a term never reshuffles another.
+const STREAM_IMU: u64 = 1;
+
+fn draw3(noise: &mut Noise) -> Vector3<f64> {
+    Vector3::new(noise.normal(), noise.normal(), noise.normal())
+}
+
+impl TriadState {
+    fn new(m: &TriadModel, noise: &mut Noise) -> Self {
+        let turn_on = m.turn_on.component_mul(&draw3(noise));
+        // Start the Gauss–Markov process in its stationary distribution.
+        let gm = m.gm_sigma.component_mul(&draw3(noise));
+        Self {
+            turn_on,
+            gm,
+            rw: Vector3::zeros(),
+            carry: Vector3::zeros(),
+        }
+    }
+
+    /// Advance the random processes over `dt` and return the erroneous increment of
+    /// the true increment `x` (before g-sensitivity and vibration, which the caller
+    /// adds, and before quantization).
+    fn corrupt(
+        &mut self,
+        m: &TriadModel,
+        x: &Vector3<f64>,
+        dt: f64,
+        noise: &mut Noise,
+    ) -> Vector3<f64> {
+        let w_gm = draw3(noise);
+        let w_rw = draw3(noise);
+        let w_white = draw3(noise);
+        let mut y = Vector3::zeros();
+        for i in 0..3 {
+            if m.gm_sigma[i] > 0.0 && m.gm_tau[i] > 0.0 {
+                let phi = (-dt / m.gm_tau[i]).exp();
+                self.gm[i] = phi * self.gm[i] + m.gm_sigma[i] * (1.0 - phi * phi).sqrt() * w_gm[i];
+            }
+            self.rw[i] += m.random_walk[i] * dt.sqrt() * w_rw[i];
+            let gain = 1.0 + m.scale[i] + m.asymmetry[i] * x[i].signum();
+            let mut cross = 0.0;
+            for j in 0..3 {
+                if j != i {
+                    cross += m.misalignment[(i, j)] * x[j];
+                }
+            }
+            let bias = m.bias[i] + self.turn_on[i] + self.gm[i] + self.rw[i];
+            y[i] = gain * x[i] + cross + bias * dt + m.white[i] * dt.sqrt() * w_white[i];
+        }
+        y
+    }
+
+    /// Quantize with carry: output whole steps, keep the remainder for the next sample.
+    fn quantize(&mut self, m: &TriadModel, y: Vector3<f64>) -> Vector3<f64> {
+        let mut out = y;
+        for i in 0..3 {
+            let q = m.quantum[i];
+            if q > 0.0 {
+                let total = y[i] + self.carry[i];
+                out[i] = (total / q).round() * q;
+                self.carry[i] = total - out[i];
+            }
+        }
+        out
+    }
+}
+
+impl ImuSimulator {
+    /// A simulator of `model` whose random draws come from `seed`.
+    pub fn new(model: ImuModel, seed: u64) -> Self {
+        let mut noise = Noise::new(seed, STREAM_IMU);
+        let gyro = TriadState::new(&model.gyro, &mut noise);
+        let accel = TriadState::new(&model.accel, &mut noise);
+        Self {
+            model,
+            gyro,
+            accel,
+            noise,
+        }
+    }
+
+    /// The turn-on biases drawn for this run (gyro, accelerometer), for the record.
+    pub fn turn_on_biases(&self) -> (Vector3<f64>, Vector3<f64>) {
+        (self.gyro.turn_on, self.accel.turn_on)
+    }
+
+    /// The measured sample for a true sample.
+    pub fn measure(&mut self, truth: &ImuSample) -> ImuSample {
+        let dt = truth.dt;
+        let m = &self.model;
+        let mut dtheta = self
+            .gyro
+            .corrupt(&m.gyro, &truth.dtheta, dt, &mut self.noise);
+        dtheta += m.g_sensitivity * truth.dvel;
+        let mut dvel = self
+            .accel
+            .corrupt(&m.accel, &truth.dvel, dt, &mut self.noise);
+        let (t0, t1) = (truth.t - dt, truth.t);
+        for line in &m.vibration {
+            let w = std::f64::consts::TAU * line.freq_hz;
+            if w > 0.0 {
+                // ∫ A sin(w t + φ) dt = A/w (cos(w t0 + φ) - cos(w t1 + φ)).
+                let k = ((w * t0 + line.phase).cos() - (w * t1 + line.phase).cos()) / w;
+                dvel += line.amplitude * k;
+            }
+        }
+        ImuSample {
+            dtheta: self.gyro.quantize(&m.gyro, dtheta),
+            dvel: self.accel.quantize(&m.accel, dvel),
+            ..*truth
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn sample(t: f64, dt: f64) -> ImuSample {
+        ImuSample {
+            t,
+            dt,
+            dtheta: Vector3::new(1e-3, -2e-3, 5e-4),
+            dvel: Vector3::new(0.01, 0.0, -0.049),
+        }
+    }
+
+    /// Constant bias and scale factor show up exactly: y = (1 + s) x + b dt.
+    #[test]
+    fn bias_and_scale_are_exact() {
+        let mut m = ImuModel::default();
+        m.gyro.bias = Vector3::new(1e-5, 0.0, 0.0);
+        m.accel.scale = Vector3::new(0.0, 0.0, 1e-4);
+        let mut sim = ImuSimulator::new(m, 1);
+        let s = sample(1.0, 0.005);
+        let y = sim.measure(&s);
+        assert_eq!(y.dtheta.x, 1e-3 + 1e-5 * 0.005);
+        assert_eq!(y.dtheta.y, -2e-3);
+        assert_relative_eq!(y.dvel.z, -0.049 * 1.0001, max_relative = 1e-16);
+    }
+
+    /// Quantization: every output is a whole number of steps, and the running sum
+    /// stays within one step of the true sum (carry).
+    #[test]
+    fn quantization_steps_and_carry() {
+        let mut m = ImuModel::default();
+        let q = 1e-6;
+        m.gyro.quantum = Vector3::new(q, q, q);
+        let mut sim = ImuSimulator::new(m, 1);
+        let (mut sum_in, mut sum_out) = (0.0, 0.0);
+        for k in 1..=1000 {
+            let s = sample(k as f64 * 0.005, 0.005);
+            let y = sim.measure(&s);
+            let steps = y.dtheta.x / q;
+            assert!((steps - steps.round()).abs() < 1e-6, "{steps}");
+            sum_in += s.dtheta.x;
+            sum_out += y.dtheta.x;
+        }
+        assert!((sum_in - sum_out).abs() <= 0.5 * q + 1e-12);
+    }
+
+    /// Vibration integrates exactly: over a whole number of periods the lines add
+    /// nothing to the velocity.
+    #[test]
+    fn vibration_integrates_to_zero_over_periods() {
+        let mut m = ImuModel::default();
+        m.vibration.push(VibrationLine {
+            freq_hz: 20.0,
+            amplitude: Vector3::new(0.5, 0.0, 1.0),
+            phase: 0.3,
+        });
+        let mut sim = ImuSimulator::new(m, 1);
+        let mut sum = Vector3::zeros();
+        for k in 1..=200 {
+            let s = ImuSample {
+                dvel: Vector3::zeros(),
+                ..sample(k as f64 * 0.005, 0.005)
+            };
+            sum += sim.measure(&s).dvel;
+        }
+        assert!(sum.norm() < 1e-14, "{sum}");
+    }
+}
