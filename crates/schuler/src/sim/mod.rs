@@ -5,5 +5,8 @@ pub mod imu_model;
 pub mod jet;
 pub mod motion;
 pub mod random;
+pub mod receivers;
+pub mod run;
 pub mod scenario;
+pub mod sensor_spec;
 pub mod spline;

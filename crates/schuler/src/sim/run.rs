@@ -1,0 +1,206 @@
+//! A whole simulation: scenario in, truth and sensor streams out, through a sink.
+//!
+//! IMU samples are taken at `t0 + k/rate` for `k = 0..=N`; sample `k` holds the exact
+//! increments over `((k-1)/rate, k/rate]` corrupted by the IMU model, so sample 0 ends
+//! at the start time and carries the initial state (as `schuler nav` expects). GNSS and
+//! barometer epochs fall on `t0 + j/rate` of their own rates.
+
+use super::analytic::{self, Kinematics, Trajectory};
+use super::imu_model::ImuSimulator;
+use super::receivers::{BaroReading, BaroSimulator, GnssFix, GnssSimulator};
+use super::scenario::{MotionSpec, ScenarioError, SegmentSpec, StartSpec};
+use super::sensor_spec::{BaroSpec, GnssSpec, ImuSpec};
+use super::spline::SplineTrajectory;
+use crate::earth::{EarthModel, Sphere, Wgs84};
+use crate::imu::ImuSample;
+use crate::nav::NavState;
+use serde::{Deserialize, Serialize};
+
+/// The Earth model of a scenario.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EarthSpec {
+    /// WGS84.
+    #[default]
+    Wgs84,
+    /// The textbook's rotating sphere.
+    Sphere,
+    /// The textbook's sphere without rotation.
+    SphereFixed,
+}
+
+/// A complete scenario as written in TOML.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    /// Master seed of every random draw.
+    #[serde(default)]
+    pub seed: u64,
+    /// Earth model.
+    #[serde(default)]
+    pub earth: EarthSpec,
+    /// Initial state.
+    pub start: StartSpec,
+    /// Maneuvers.
+    pub motion: Vec<SegmentSpec>,
+    /// IMU.
+    pub imu: ImuSpec,
+    /// GNSS receiver (none if absent).
+    pub gnss: Option<GnssSpec>,
+    /// Barometer (none if absent).
+    pub baro: Option<BaroSpec>,
+}
+
+impl ScenarioSpec {
+    /// The scenario as actually used: presets folded in, everything explicit.
+    pub fn resolved(&self) -> ScenarioSpec {
+        ScenarioSpec {
+            imu: self.imu.resolved_spec(),
+            ..self.clone()
+        }
+    }
+
+    /// The motion part.
+    pub fn motion_spec(&self) -> MotionSpec {
+        MotionSpec {
+            start: self.start.clone(),
+            motion: self.motion.clone(),
+        }
+    }
+}
+
+/// Receives the simulated streams in time order.
+pub trait SimSink {
+    /// One IMU epoch: the exact and the measured sample, the truth at its end time and
+    /// the instantaneous kinematics there.
+    fn imu(
+        &mut self,
+        exact: &ImuSample,
+        measured: &ImuSample,
+        truth: &NavState,
+        kin: &Kinematics,
+    ) -> std::io::Result<()>;
+    /// One GNSS fix.
+    fn gnss(&mut self, fix: &GnssFix) -> std::io::Result<()>;
+    /// One barometer reading.
+    fn baro(&mut self, reading: &BaroReading) -> std::io::Result<()>;
+}
+
+/// Why a simulation failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    /// The scenario is invalid.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The sink failed to write.
+    #[error("writing the simulated data failed: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// What a simulation produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimSummary {
+    /// IMU samples written (including sample 0).
+    pub imu_samples: u64,
+    /// GNSS fixes written.
+    pub gnss_fixes: u64,
+    /// Barometer readings written.
+    pub baro_readings: u64,
+    /// Start and end time [s].
+    pub t0: f64,
+    /// End time [s].
+    pub t1: f64,
+}
+
+/// Run `spec` into `sink`.
+pub fn simulate(spec: &ScenarioSpec, sink: &mut impl SimSink) -> Result<SimSummary, SimError> {
+    match spec.earth {
+        EarthSpec::Wgs84 => simulate_on(Wgs84, spec, sink),
+        EarthSpec::Sphere => simulate_on(Sphere::textbook(true), spec, sink),
+        EarthSpec::SphereFixed => simulate_on(Sphere::textbook(false), spec, sink),
+    }
+}
+
+/// Angular rate of the body relative to the navigation frame, `w_nb_b = w_ib_b -
+/// C_nb (w_ie_n + w_en_n)`, for the GNSS lever-arm velocity.
+fn w_nb_b<E: EarthModel>(earth: &E, s: &NavState, k: &Kinematics) -> nalgebra::Vector3<f64> {
+    let l = earth.local(s.pos.lat, s.pos.h);
+    k.w_ib_b - s.q_bn.inverse() * (l.w_ie_n() + l.w_en_n(&s.v_n))
+}
+
+/// Run `spec` on a given Earth model.
+pub fn simulate_on<E: EarthModel>(
+    earth: E,
+    spec: &ScenarioSpec,
+    sink: &mut impl SimSink,
+) -> Result<SimSummary, SimError> {
+    let imu_model = spec.imu.model()?;
+    let gnss_model = spec.gnss.as_ref().map(GnssSpec::model).transpose()?;
+    let baro_model = spec.baro.as_ref().map(BaroSpec::model).transpose()?;
+    let traj: SplineTrajectory = spec.motion_spec().build(earth)?;
+    let (t0, t1) = (traj.start(), traj.end());
+    let dt = 1.0 / spec.imu.rate_hz;
+    let n = ((t1 - t0) / dt + 1e-9).floor() as u64;
+    let mut imu = ImuSimulator::new(imu_model, spec.seed);
+    let mut gnss = gnss_model.map(|m| GnssSimulator::new(m, spec.seed));
+    let mut baro = baro_model.map(|m| BaroSimulator::new(m, spec.seed));
+    let mut summary = SimSummary {
+        imu_samples: 0,
+        gnss_fixes: 0,
+        baro_readings: 0,
+        t0,
+        t1,
+    };
+    let (mut next_gnss, mut next_baro) = (0u64, 0u64);
+    for k in 0..=n {
+        let t = t0 + k as f64 * dt;
+        let exact = analytic::increment(&earth, &traj, t, dt);
+        let measured = imu.measure(&exact);
+        let truth = analytic::state(&earth, &traj, t);
+        let kin = analytic::kinematics(&earth, &traj, t);
+        sink.imu(&exact, &measured, &truth, &kin)?;
+        summary.imu_samples += 1;
+        // Aiding epochs that fall in (t - dt, t] are taken at their own exact times.
+        if let Some(g) = gnss.as_mut() {
+            emit_epochs(&mut next_gnss, g.interval(), t0, t, |te| {
+                let s = analytic::state(&earth, &traj, te);
+                let kin = analytic::kinematics(&earth, &traj, te);
+                if let Some(fix) = g.fix(&earth, &s, &w_nb_b(&earth, &s, &kin)) {
+                    sink.gnss(&fix)?;
+                    summary.gnss_fixes += 1;
+                }
+                Ok(())
+            })?;
+        }
+        if let Some(b) = baro.as_mut() {
+            emit_epochs(&mut next_baro, b.interval(), t0, t, |te| {
+                let h = traj.position(super::jet::Jet::constant(te))[2].v;
+                if let Some(r) = b.reading(te, t0, h) {
+                    sink.baro(&r)?;
+                    summary.baro_readings += 1;
+                }
+                Ok(())
+            })?;
+        }
+    }
+    Ok(summary)
+}
+
+/// Call `f` for every epoch `t0 + j*interval <= t` not yet emitted.
+fn emit_epochs(
+    next: &mut u64,
+    interval: f64,
+    t0: f64,
+    t: f64,
+    mut f: impl FnMut(f64) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    loop {
+        let te = t0 + *next as f64 * interval;
+        if te > t + 1e-9 * interval {
+            return Ok(());
+        }
+        f(te)?;
+        *next += 1;
+    }
+}

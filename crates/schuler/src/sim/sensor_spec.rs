@@ -1,0 +1,516 @@
+//! Sensor descriptions in engineering units, IMU grade presets, and their resolution
+//! into the SI models of [`super::imu_model`] and [`super::receivers`].
+//!
+//! Presets (typical one-sigma values of the three classic grades, after Groves,
+//! *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd
+//! ed. 2013, §4.4 and table 4.1, and Titterton & Weston 2004 table 1.1; the seed's
+//! FOG system is of the first class):
+//!
+//! | preset | gyro turn-on bias | gyro instability (τ) | ARW | accel turn-on bias | accel instability (τ) | VRW | scale gyro / accel |
+//! |---|---|---|---|---|---|---|---|
+//! | `navigation` (FOG/RLG) | 0.01 deg/h | 0.003 deg/h (3600 s) | 0.002 deg/sqrt(h) | 50 ug | 10 ug (3600 s) | 0.01 m/s/sqrt(h) | 5 / 50 ppm |
+//! | `tactical` | 1 deg/h | 0.1 deg/h (1800 s) | 0.1 deg/sqrt(h) | 1 mg | 50 ug (1800 s) | 0.05 m/s/sqrt(h) | 100 / 300 ppm |
+//! | `consumer-mems` | 10 deg/h | 3 deg/h (300 s) | 0.5 deg/sqrt(h) | 5 mg | 0.5 mg (300 s) | 0.2 m/s/sqrt(h) | 1000 / 3000 ppm |
+//! | `perfect` | none | | | | | | |
+
+use super::imu_model::{ImuModel, TriadModel, VibrationLine};
+use super::receivers::{BaroModel, GnssModel, Interval, Outlier};
+use super::scenario::{Quantity, ScenarioError};
+use crate::units::Dimension;
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A per-axis value: one quantity for all three axes, or one per axis.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum Axes {
+    /// The same on x, y, z.
+    All(Quantity),
+    /// x, y, z.
+    Each([Quantity; 3]),
+}
+
+impl Axes {
+    fn si(&self, key: &str, dim: Dimension) -> Result<Vector3<f64>, ScenarioError> {
+        match self {
+            Axes::All(q) => {
+                let v = q.si(key, dim)?;
+                Ok(Vector3::new(v, v, v))
+            }
+            Axes::Each(qs) => {
+                let mut v = Vector3::zeros();
+                for (i, q) in qs.iter().enumerate() {
+                    v[i] = q.si(&format!("{key}[{i}]"), dim)?;
+                }
+                Ok(v)
+            }
+        }
+    }
+}
+
+fn text(s: &str) -> Option<Axes> {
+    Some(Axes::All(Quantity::Text(s.to_string())))
+}
+
+/// One triad's errors as written; every field optional (a preset or zero fills it).
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TriadSpec {
+    /// Constant bias.
+    pub bias: Option<Axes>,
+    /// Turn-on bias standard deviation (drawn once per run).
+    pub turn_on: Option<Axes>,
+    /// Gauss–Markov bias instability (standard deviation).
+    pub instability: Option<Axes>,
+    /// Gauss–Markov correlation time.
+    pub correlation_time: Option<Axes>,
+    /// White noise: angle random walk (gyro) or velocity random walk (accelerometer).
+    pub random_walk: Option<Axes>,
+    /// Scale-factor error.
+    pub scale: Option<Axes>,
+    /// Scale-factor asymmetry.
+    pub asymmetry: Option<Axes>,
+    /// Misalignment angles `[xy, xz, yx, yz, zx, zy]` (sensor axis, true axis).
+    pub misalignment: Option<[Quantity; 6]>,
+    /// Quantization step of the increments.
+    pub quantum: Option<Axes>,
+}
+
+impl TriadSpec {
+    /// `self` with every missing field taken from `base`.
+    fn over(&self, base: &TriadSpec) -> TriadSpec {
+        macro_rules! pick {
+            ($($f:ident),*) => { TriadSpec { $($f: self.$f.clone().or_else(|| base.$f.clone()),)* } };
+        }
+        pick!(
+            bias,
+            turn_on,
+            instability,
+            correlation_time,
+            random_walk,
+            scale,
+            asymmetry,
+            misalignment,
+            quantum
+        )
+    }
+
+    fn resolve(
+        &self,
+        key: &str,
+        rate: Dimension,
+        white: Dimension,
+        quantum: Dimension,
+    ) -> Result<TriadModel, ScenarioError> {
+        let get =
+            |f: &Option<Axes>, name: &str, dim: Dimension| -> Result<Vector3<f64>, ScenarioError> {
+                f.as_ref().map_or(Ok(Vector3::zeros()), |a| {
+                    a.si(&format!("{key}.{name}"), dim)
+                })
+            };
+        let mut misalignment = Matrix3::zeros();
+        if let Some(m) = &self.misalignment {
+            let slots = [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)];
+            for (q, (i, j)) in m.iter().zip(slots) {
+                misalignment[(i, j)] = q.si(&format!("{key}.misalignment"), Dimension::Angle)?;
+            }
+        }
+        let model = TriadModel {
+            bias: get(&self.bias, "bias", rate)?,
+            turn_on: get(&self.turn_on, "turn_on", rate)?,
+            gm_sigma: get(&self.instability, "instability", rate)?,
+            gm_tau: get(&self.correlation_time, "correlation_time", Dimension::Time)?,
+            white: get(&self.random_walk, "random_walk", white)?,
+            random_walk: Vector3::zeros(),
+            scale: get(&self.scale, "scale", Dimension::Dimensionless)?,
+            asymmetry: get(&self.asymmetry, "asymmetry", Dimension::Dimensionless)?,
+            misalignment,
+            quantum: get(&self.quantum, "quantum", quantum)?,
+        };
+        for i in 0..3 {
+            if model.gm_sigma[i] != 0.0 && model.gm_tau[i] <= 0.0 {
+                return Err(ScenarioError::Value {
+                    key: format!("{key}.correlation_time"),
+                    message: "a bias instability needs a positive correlation time".into(),
+                });
+            }
+            for (name, v) in [
+                ("turn_on", model.turn_on[i]),
+                ("instability", model.gm_sigma[i]),
+                ("random_walk", model.white[i]),
+                ("quantum", model.quantum[i]),
+            ] {
+                if v < 0.0 {
+                    return Err(ScenarioError::Value {
+                        key: format!("{key}.{name}"),
+                        message: format!(
+                            "a standard deviation or step cannot be negative, got {v}"
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(model)
+    }
+}
+
+/// IMU grade presets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// Navigation grade (FOG/RLG, about 0.01 deg/h and 50 ug).
+    Navigation,
+    /// Tactical grade (about 1 deg/h and 1 mg).
+    Tactical,
+    /// Consumer MEMS (about 10 deg/h and 5 mg).
+    ConsumerMems,
+    /// No errors.
+    Perfect,
+}
+
+impl Preset {
+    /// The preset's gyro and accelerometer specs (module table).
+    pub fn specs(self) -> (TriadSpec, TriadSpec) {
+        let triad = |bias: &str, instab: &str, tau: &str, rw: &str, scale: &str| TriadSpec {
+            turn_on: text(bias),
+            instability: text(instab),
+            correlation_time: text(tau),
+            random_walk: text(rw),
+            scale: text(scale),
+            ..TriadSpec::default()
+        };
+        match self {
+            Preset::Navigation => (
+                triad(
+                    "0.01 deg/h",
+                    "0.003 deg/h",
+                    "3600 s",
+                    "0.002 deg/sqrt(h)",
+                    "5 ppm",
+                ),
+                triad("50 ug", "10 ug", "3600 s", "0.01 m/s/sqrt(h)", "50 ppm"),
+            ),
+            Preset::Tactical => (
+                triad(
+                    "1 deg/h",
+                    "0.1 deg/h",
+                    "1800 s",
+                    "0.1 deg/sqrt(h)",
+                    "100 ppm",
+                ),
+                triad("1 mg", "50 ug", "1800 s", "0.05 m/s/sqrt(h)", "300 ppm"),
+            ),
+            Preset::ConsumerMems => (
+                triad(
+                    "10 deg/h",
+                    "3 deg/h",
+                    "300 s",
+                    "0.5 deg/sqrt(h)",
+                    "1000 ppm",
+                ),
+                triad("5 mg", "0.5 mg", "300 s", "0.2 m/s/sqrt(h)", "3000 ppm"),
+            ),
+            Preset::Perfect => (TriadSpec::default(), TriadSpec::default()),
+        }
+    }
+}
+
+/// A vibration line as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct VibrationSpec {
+    /// Frequency [Hz].
+    pub freq_hz: f64,
+    /// Amplitude per axis (acceleration).
+    pub amplitude: Axes,
+    /// Phase (angle), default 0.
+    pub phase: Option<Quantity>,
+}
+
+/// The IMU as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuSpec {
+    /// Sample rate [Hz].
+    pub rate_hz: f64,
+    /// Base grade; fields given below override it.
+    pub preset: Option<Preset>,
+    /// Gyro errors.
+    #[serde(default)]
+    pub gyro: TriadSpec,
+    /// Accelerometer errors.
+    #[serde(default)]
+    pub accel: TriadSpec,
+    /// Gyro g-sensitivity, rad/s per m/s^2, per axis (diagonal) [dimensionless in SI:
+    /// write e.g. 1e-6].
+    pub g_sensitivity: Option<[f64; 3]>,
+    /// Accelerometer vibration lines.
+    #[serde(default)]
+    pub vibration: Vec<VibrationSpec>,
+}
+
+impl ImuSpec {
+    /// The spec with the preset folded in (what was actually used, for the record).
+    pub fn resolved_spec(&self) -> ImuSpec {
+        let (g, a) = self.preset.unwrap_or(Preset::Perfect).specs();
+        ImuSpec {
+            gyro: self.gyro.over(&g),
+            accel: self.accel.over(&a),
+            preset: None,
+            ..self.clone()
+        }
+    }
+
+    /// The SI model.
+    pub fn model(&self) -> Result<ImuModel, ScenarioError> {
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+            return Err(ScenarioError::Value {
+                key: "imu.rate_hz".into(),
+                message: format!("must be a positive number of Hz, got {}", self.rate_hz),
+            });
+        }
+        let r = self.resolved_spec();
+        let gyro = r.gyro.resolve(
+            "imu.gyro",
+            Dimension::AngularRate,
+            Dimension::AngleRandomWalk,
+            Dimension::Angle,
+        )?;
+        let accel = r.accel.resolve(
+            "imu.accel",
+            Dimension::Acceleration,
+            Dimension::VelocityRandomWalk,
+            Dimension::Velocity,
+        )?;
+        let mut vibration = Vec::new();
+        for (i, v) in r.vibration.iter().enumerate() {
+            let key = format!("imu.vibration[{i}]");
+            if !(v.freq_hz.is_finite() && v.freq_hz > 0.0) {
+                return Err(ScenarioError::Value {
+                    key: format!("{key}.freq_hz"),
+                    message: format!("must be a positive frequency, got {}", v.freq_hz),
+                });
+            }
+            vibration.push(VibrationLine {
+                freq_hz: v.freq_hz,
+                amplitude: v
+                    .amplitude
+                    .si(&format!("{key}.amplitude"), Dimension::Acceleration)?,
+                phase: v
+                    .phase
+                    .as_ref()
+                    .map_or(Ok(0.0), |p| p.si(&format!("{key}.phase"), Dimension::Angle))?,
+            });
+        }
+        Ok(ImuModel {
+            gyro,
+            accel,
+            g_sensitivity: Matrix3::from_diagonal(&Vector3::from(
+                r.g_sensitivity.unwrap_or([0.0; 3]),
+            )),
+            vibration,
+        })
+    }
+}
+
+/// An interval as written: `["215 s", "276 s"]`.
+pub type IntervalSpec = [Quantity; 2];
+
+fn intervals(specs: &[IntervalSpec], key: &str) -> Result<Vec<Interval>, ScenarioError> {
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, [a, b])| {
+            let k = format!("{key}[{i}]");
+            let (start, end) = (a.si(&k, Dimension::Time)?, b.si(&k, Dimension::Time)?);
+            if end < start {
+                return Err(ScenarioError::Value {
+                    key: k,
+                    message: format!("the interval ends ({end} s) before it starts ({start} s)"),
+                });
+            }
+            Ok(Interval { start, end })
+        })
+        .collect()
+}
+
+/// A GNSS receiver as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GnssSpec {
+    /// Output rate [Hz].
+    pub rate_hz: f64,
+    /// Position noise std N, E, D.
+    pub position_std: [Quantity; 3],
+    /// Velocity noise std N, E, D.
+    pub velocity_std: Option<[Quantity; 3]>,
+    /// Antenna lever arm in body axes.
+    pub lever_arm: Option<[Quantity; 3]>,
+    /// Outages `[start, end]`.
+    #[serde(default)]
+    pub outages: Vec<IntervalSpec>,
+    /// Outliers: time and NED jump.
+    #[serde(default)]
+    pub outliers: Vec<GnssOutlierSpec>,
+}
+
+/// A GNSS outlier as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GnssOutlierSpec {
+    /// Time.
+    pub at: Quantity,
+    /// NED jump.
+    pub jump: [Quantity; 3],
+}
+
+fn vec3(q: &[Quantity; 3], key: &str, dim: Dimension) -> Result<Vector3<f64>, ScenarioError> {
+    Axes::Each(q.clone()).si(key, dim)
+}
+
+impl GnssSpec {
+    /// The SI model.
+    pub fn model(&self) -> Result<GnssModel, ScenarioError> {
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+            return Err(ScenarioError::Value {
+                key: "gnss.rate_hz".into(),
+                message: format!("must be a positive number of Hz, got {}", self.rate_hz),
+            });
+        }
+        let zero = || Ok(Vector3::zeros());
+        Ok(GnssModel {
+            interval: 1.0 / self.rate_hz,
+            pos_std: vec3(&self.position_std, "gnss.position_std", Dimension::Length)?,
+            vel_std: self
+                .velocity_std
+                .as_ref()
+                .map_or_else(zero, |v| vec3(v, "gnss.velocity_std", Dimension::Velocity))?,
+            lever_arm: self
+                .lever_arm
+                .as_ref()
+                .map_or_else(zero, |v| vec3(v, "gnss.lever_arm", Dimension::Length))?,
+            outages: intervals(&self.outages, "gnss.outages")?,
+            outliers: self
+                .outliers
+                .iter()
+                .enumerate()
+                .map(|(i, o)| {
+                    let k = format!("gnss.outliers[{i}]");
+                    Ok(Outlier {
+                        t: o.at.si(&format!("{k}.at"), Dimension::Time)?,
+                        jump: vec3(&o.jump, &format!("{k}.jump"), Dimension::Length)?,
+                    })
+                })
+                .collect::<Result<_, ScenarioError>>()?,
+        })
+    }
+}
+
+/// A barometer as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaroSpec {
+    /// Output rate [Hz].
+    pub rate_hz: f64,
+    /// Constant bias (length).
+    pub bias: Option<Quantity>,
+    /// Drift (velocity, e.g. "0.01 m/s").
+    pub drift: Option<Quantity>,
+    /// White noise std (length).
+    pub noise: Option<Quantity>,
+    /// Dropouts `[start, end]`.
+    #[serde(default)]
+    pub dropouts: Vec<IntervalSpec>,
+    /// Outliers: time and height jump.
+    #[serde(default)]
+    pub outliers: Vec<BaroOutlierSpec>,
+}
+
+/// A barometer outlier as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaroOutlierSpec {
+    /// Time.
+    pub at: Quantity,
+    /// Height jump.
+    pub jump: Quantity,
+}
+
+impl BaroSpec {
+    /// The SI model.
+    pub fn model(&self) -> Result<BaroModel, ScenarioError> {
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+            return Err(ScenarioError::Value {
+                key: "baro.rate_hz".into(),
+                message: format!("must be a positive number of Hz, got {}", self.rate_hz),
+            });
+        }
+        let opt =
+            |q: &Option<Quantity>, key: &str, dim| q.as_ref().map_or(Ok(0.0), |q| q.si(key, dim));
+        Ok(BaroModel {
+            interval: 1.0 / self.rate_hz,
+            bias: opt(&self.bias, "baro.bias", Dimension::Length)?,
+            drift: opt(&self.drift, "baro.drift", Dimension::Velocity)?,
+            noise: opt(&self.noise, "baro.noise", Dimension::Length)?,
+            dropouts: intervals(&self.dropouts, "baro.dropouts")?,
+            outliers: self
+                .outliers
+                .iter()
+                .enumerate()
+                .map(|(i, o)| {
+                    let k = format!("baro.outliers[{i}]");
+                    Ok(Outlier {
+                        t: o.at.si(&format!("{k}.at"), Dimension::Time)?,
+                        jump: o.jump.si(&format!("{k}.jump"), Dimension::Length)?,
+                    })
+                })
+                .collect::<Result<_, ScenarioError>>()?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::{DEG_PER_H, DEG_PER_SQRT_H, UG};
+    use approx::assert_relative_eq;
+
+    /// The tactical preset resolves to its table values; a field given overrides it.
+    #[test]
+    fn preset_values_and_override() {
+        let spec: ImuSpec = toml::from_str(
+            "rate_hz = 200\npreset = \"tactical\"\n[accel]\nturn_on = [\"100 ug\", \"200 ug\", \"300 ug\"]\n",
+        )
+        .expect("toml");
+        let m = spec.model().expect("model");
+        assert_relative_eq!(m.gyro.turn_on.x, DEG_PER_H, max_relative = 1e-15);
+        assert_relative_eq!(m.gyro.white.z, 0.1 * DEG_PER_SQRT_H, max_relative = 1e-15);
+        assert_relative_eq!(m.accel.turn_on.y, 200.0 * UG, max_relative = 1e-15);
+        assert_relative_eq!(m.gyro.gm_tau.y, 1800.0);
+        let back = toml::to_string(&spec.resolved_spec()).expect("serialize");
+        assert!(back.contains("0.1 deg/h"), "{back}");
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let spec: ImuSpec =
+            toml::from_str("rate_hz = 200\n[gyro]\nbias = \"1 mg\"\n").expect("toml");
+        let e = spec.model().unwrap_err().to_string();
+        assert!(
+            e.starts_with("imu.gyro.bias: expected an angular rate"),
+            "{e}"
+        );
+        let spec: ImuSpec =
+            toml::from_str("rate_hz = 200\n[gyro]\ninstability = \"1 deg/h\"\n").expect("toml");
+        assert!(
+            spec.model()
+                .unwrap_err()
+                .to_string()
+                .starts_with("imu.gyro.correlation_time")
+        );
+        let e = toml::from_str::<ImuSpec>("rate_hz = 200\n[gyro]\nbais = \"1 deg/h\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown field `bais`"), "{e}");
+    }
+}
