@@ -19,6 +19,8 @@ enum Command {
     Nav(schuler_cli::commands::nav::NavArgs),
     /// A first end-to-end run on built-in simulated data.
     Demo(schuler_cli::commands::demo::DemoArgs),
+    /// Simulate a trajectory and its IMU, GNSS and barometer data.
+    Simulate(schuler_cli::commands::simulate::Args),
 }
 
 fn main() -> ExitCode {
@@ -26,6 +28,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Nav(args) => schuler_cli::commands::nav::run(args),
         Command::Demo(args) => schuler_cli::commands::demo::run(args),
+        Command::Simulate(args) => schuler_cli::commands::simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
