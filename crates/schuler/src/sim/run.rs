@@ -153,38 +153,107 @@ pub fn simulate_on<E: EarthModel>(
         t1,
     };
     let (mut next_gnss, mut next_baro) = (0u64, 0u64);
-    for k in 0..=n {
-        let t = t0 + k as f64 * dt;
-        let exact = analytic::increment(&earth, &traj, t, dt);
-        let measured = imu.measure(&exact);
-        let truth = analytic::state(&earth, &traj, t);
-        let kin = analytic::kinematics(&earth, &traj, t);
-        sink.imu(&exact, &measured, &truth, &kin)?;
-        summary.imu_samples += 1;
-        // Aiding epochs that fall in (t - dt, t] are taken at their own exact times.
-        if let Some(g) = gnss.as_mut() {
-            emit_epochs(&mut next_gnss, g.interval(), t0, t, |te| {
-                let s = analytic::state(&earth, &traj, te);
-                let kin = analytic::kinematics(&earth, &traj, te);
-                if let Some(fix) = g.fix(&earth, &s, &w_nb_b(&earth, &s, &kin)) {
-                    sink.gnss(&fix)?;
-                    summary.gnss_fixes += 1;
-                }
-                Ok(())
-            })?;
+    let threads = std::thread::available_parallelism()
+        .map_or(1, usize::from)
+        .clamp(1, 8);
+    let mut before = analytic::kinematics(&earth, &traj, t0 - dt);
+    let mut k0 = 0u64;
+    while k0 <= n {
+        let k1 = (k0 + BLOCK).min(n + 1);
+        let block = exact_block(&earth, &traj, t0, dt, k0, k1, &before, threads);
+        for (exact, truth, kin) in &block {
+            let t = exact.t;
+            let measured = imu.measure(exact);
+            sink.imu(exact, &measured, truth, kin)?;
+            summary.imu_samples += 1;
+            // Aiding epochs that fall in (t - dt, t] are taken at their own exact times.
+            if let Some(g) = gnss.as_mut() {
+                emit_epochs(&mut next_gnss, g.interval(), t0, t, |te| {
+                    let (s, kin) = analytic::evaluate(&earth, &traj, te);
+                    if let Some(fix) = g.fix(&earth, &s, &w_nb_b(&earth, &s, &kin)) {
+                        sink.gnss(&fix)?;
+                        summary.gnss_fixes += 1;
+                    }
+                    Ok(())
+                })?;
+            }
+            if let Some(b) = baro.as_mut() {
+                emit_epochs(&mut next_baro, b.interval(), t0, t, |te| {
+                    let h = traj.position(super::jet::Jet::constant(te))[2].v;
+                    if let Some(r) = b.reading(te, t0, h) {
+                        sink.baro(&r)?;
+                        summary.baro_readings += 1;
+                    }
+                    Ok(())
+                })?;
+            }
         }
-        if let Some(b) = baro.as_mut() {
-            emit_epochs(&mut next_baro, b.interval(), t0, t, |te| {
-                let h = traj.position(super::jet::Jet::constant(te))[2].v;
-                if let Some(r) = b.reading(te, t0, h) {
-                    sink.baro(&r)?;
-                    summary.baro_readings += 1;
-                }
-                Ok(())
-            })?;
+        if let Some(last) = block.last() {
+            before = last.2;
         }
+        k0 = k1;
     }
     Ok(summary)
+}
+
+/// Samples computed per block (in parallel, then written in order).
+const BLOCK: u64 = 8192;
+
+/// One exact sample with the truth and kinematics at its end.
+type Exact = (ImuSample, NavState, Kinematics);
+
+/// Exact samples `k0..k1` (sample `k` ends at `t0 + k dt`), split over `threads`
+/// threads. Each sample is a pure function of its time, so the result does not depend
+/// on the split: the same bits with one thread or eight.
+#[allow(clippy::too_many_arguments)]
+fn exact_block<E: EarthModel, T: Trajectory + Sync>(
+    earth: &E,
+    traj: &T,
+    t0: f64,
+    dt: f64,
+    k0: u64,
+    k1: u64,
+    before: &Kinematics,
+    threads: usize,
+) -> Vec<Exact> {
+    let run = |from: u64, to: u64, mut prev: Kinematics| -> Vec<Exact> {
+        (from..to)
+            .map(|k| {
+                let r = analytic::increment_from(earth, traj, t0 + k as f64 * dt, dt, &prev);
+                prev = r.2;
+                r
+            })
+            .collect()
+    };
+    let len = k1 - k0;
+    if threads <= 1 || len < 64 {
+        return run(k0, k1, *before);
+    }
+    let chunk = len.div_ceil(threads as u64);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads as u64)
+            .map(|i| {
+                let from = k0 + i * chunk;
+                let to = (from + chunk).min(k1);
+                let run = &run;
+                scope.spawn(move || {
+                    if from >= to {
+                        return Vec::new();
+                    }
+                    let prev = if i == 0 {
+                        *before
+                    } else {
+                        analytic::kinematics(earth, traj, t0 + (from as f64 - 1.0) * dt)
+                    };
+                    run(from, to, prev)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
 }
 
 /// Call `f` for every epoch `t0 + j*interval <= t` not yet emitted.

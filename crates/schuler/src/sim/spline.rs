@@ -134,6 +134,16 @@ impl Trajectory for SplineTrajectory {
         let c = self.components(t);
         JetMat3::from_euler(c[3], c[4], c[5])
     }
+
+    /// One evaluation of the components for both position and attitude.
+    fn ecef_pose<E: crate::earth::EarthModel>(&self, earth: &E, t: Jet) -> (JetVec3, JetMat3) {
+        let c = self.components(t);
+        super::analytic::geodetic_pose(
+            earth,
+            &[c[0], c[1], c[2]],
+            &JetMat3::from_euler(c[3], c[4], c[5]),
+        )
+    }
 }
 
 #[cfg(test)]
