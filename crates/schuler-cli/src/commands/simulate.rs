@@ -272,11 +272,22 @@ impl SimSink for FileSink {
     }
 }
 
-/// Read and parse a scenario file.
+/// Read and parse a scenario file, and the gnss-ins-sim motion file it names (a path
+/// relative to the scenario's folder).
 pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    toml::from_str(&text).with_context(|| format!("in {}", path.display()))
+    let mut spec: ScenarioSpec =
+        toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
+    if let Some(csv) = &spec.motion_csv {
+        let csv_path = path.parent().unwrap_or(Path::new("")).join(csv);
+        let text = std::fs::read_to_string(&csv_path)
+            .with_context(|| format!("cannot read {}", csv_path.display()))?;
+        let def = schuler::sim::gnss_ins_sim::parse(&text)
+            .with_context(|| format!("in {}", csv_path.display()))?;
+        spec.imported = Some(def);
+    }
+    Ok(spec)
 }
 
 /// Simulate `spec` into `dir`; returns the summary.

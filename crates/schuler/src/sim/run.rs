@@ -6,7 +6,10 @@
 //! barometer epochs fall on `t0 + j/rate` of their own rates.
 
 use super::analytic::{self, Kinematics, Trajectory};
+use super::gnss_ins_sim::MotionDefinition;
 use super::imu_model::ImuSimulator;
+use super::motion::{MotionBuilder, Start};
+use super::receivers::Interval;
 use super::receivers::{BaroReading, BaroSimulator, GnssFix, GnssSimulator};
 use super::scenario::{MotionSpec, ScenarioError, SegmentSpec, StartSpec};
 use super::sensor_spec::{BaroSpec, GnssSpec, ImuSpec};
@@ -39,10 +42,17 @@ pub struct ScenarioSpec {
     /// Earth model.
     #[serde(default)]
     pub earth: EarthSpec,
-    /// Initial state.
-    pub start: StartSpec,
+    /// Initial state (unless the motion comes from `motion_csv`).
+    pub start: Option<StartSpec>,
     /// Maneuvers.
+    #[serde(default)]
     pub motion: Vec<SegmentSpec>,
+    /// A gnss-ins-sim motion-definition CSV file instead of `start` and `motion`
+    /// (read by the caller into `imported`).
+    pub motion_csv: Option<String>,
+    /// The parsed `motion_csv`.
+    #[serde(skip)]
+    pub imported: Option<MotionDefinition>,
     /// IMU.
     pub imu: ImuSpec,
     /// GNSS receiver (none if absent).
@@ -60,12 +70,49 @@ impl ScenarioSpec {
         }
     }
 
-    /// The motion part.
-    pub fn motion_spec(&self) -> MotionSpec {
-        MotionSpec {
-            start: self.start.clone(),
-            motion: self.motion.clone(),
+    /// The trajectory on `earth`: from `imported` if present, else `start` and
+    /// `motion`; and the GNSS outages the motion file adds.
+    pub fn trajectory<E: EarthModel>(
+        &self,
+        earth: E,
+    ) -> Result<(SplineTrajectory, Vec<Interval>), ScenarioError> {
+        if let Some(def) = &self.imported {
+            let (pieces, outages) = def.pieces();
+            let start = Start {
+                t: self.start.as_ref().map_or(0.0, |s| s.time),
+                pos: def.pos,
+                v_n: def.attitude.to_dcm() * def.v_body,
+                attitude: def.attitude,
+            };
+            let mut b = MotionBuilder::new(earth, &start);
+            for (i, p) in pieces.iter().enumerate() {
+                b.push(p).map_err(|source| ScenarioError::Motion {
+                    key: format!("motion_csv piece {i}"),
+                    source,
+                })?;
+            }
+            let traj = b.finish().map_err(|source| ScenarioError::Motion {
+                key: "motion_csv".into(),
+                source,
+            })?;
+            let outages = outages
+                .iter()
+                .map(|[a, b]| Interval {
+                    start: start.t + a,
+                    end: start.t + b,
+                })
+                .collect();
+            return Ok((traj, outages));
         }
+        let start = self.start.clone().ok_or_else(|| ScenarioError::Value {
+            key: "start".into(),
+            message: "missing: give [start] and [[motion]], or motion_csv".into(),
+        })?;
+        let spec = MotionSpec {
+            start,
+            motion: self.motion.clone(),
+        };
+        Ok((spec.build(earth)?, Vec::new()))
     }
 }
 
@@ -136,9 +183,12 @@ pub fn simulate_on<E: EarthModel>(
     sink: &mut impl SimSink,
 ) -> Result<SimSummary, SimError> {
     let imu_model = spec.imu.model()?;
-    let gnss_model = spec.gnss.as_ref().map(GnssSpec::model).transpose()?;
+    let mut gnss_model = spec.gnss.as_ref().map(GnssSpec::model).transpose()?;
     let baro_model = spec.baro.as_ref().map(BaroSpec::model).transpose()?;
-    let traj: SplineTrajectory = spec.motion_spec().build(earth)?;
+    let (traj, motion_outages) = spec.trajectory(earth)?;
+    if let Some(g) = gnss_model.as_mut() {
+        g.outages.extend(motion_outages);
+    }
     let (t0, t1) = (traj.start(), traj.end());
     let dt = 1.0 / spec.imu.rate_hz;
     let n = ((t1 - t0) / dt + 1e-9).floor() as u64;
