@@ -256,6 +256,11 @@ impl<E: EarthModel> MotionBuilder<E> {
         }
     }
 
+    /// The Earth model.
+    pub fn earth(&self) -> E {
+        self.earth
+    }
+
     /// The current state (end of the pieces pushed so far).
     pub fn state(&self) -> Start {
         let x = &self.x;
