@@ -1,0 +1,51 @@
+//! Criterion benchmark of `schuler simulate`.
+//! `schuler simulate` throughput (issue 3 asks >= 1 million IMU samples/s generated
+//! and written): one minute of maneuvers at 1 kHz with a tactical IMU, GNSS at 1 Hz
+//! and a barometer at 10 Hz, all files written.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use schuler_cli::commands::simulate::simulate_to_dir;
+use std::path::PathBuf;
+
+const SCENARIO: &str = r#"
+seed = 3
+[start]
+position = ["45 deg", "7 deg", "300 m"]
+attitude = ["0 deg", "0 deg", "0 deg"]
+speed = "30 m/s"
+[[motion]]
+type = "turn"
+angle = "90 deg"
+bank = "20 deg"
+[[motion]]
+type = "climb"
+to_height = "400 m"
+[[motion]]
+type = "hold"
+duration = "20 s"
+[imu]
+rate_hz = 1000
+preset = "tactical"
+[gnss]
+rate_hz = 1
+position_std = ["0.5 m", "0.5 m", "1 m"]
+[baro]
+rate_hz = 10
+noise = "0.5 m"
+"#;
+
+fn bench_simulate(c: &mut Criterion) {
+    let spec = toml::from_str(SCENARIO).expect("scenario");
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("simulate_bench");
+    let samples = simulate_to_dir(&spec, &dir).expect("simulate").imu_samples;
+    let mut group = c.benchmark_group("simulate");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(samples));
+    group.bench_function("maneuvers_1khz_tactical_gnss_baro", |b| {
+        b.iter(|| simulate_to_dir(&spec, &dir).expect("simulate"))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_simulate);
+criterion_main!(benches);
