@@ -4,3 +4,4 @@
 pub mod commands;
 pub mod formats;
 pub mod output;
+pub mod plot;

@@ -21,6 +21,10 @@ enum Command {
     Demo(schuler_cli::commands::demo::DemoArgs),
     /// Simulate a trajectory and its IMU, GNSS and barometer data.
     Simulate(schuler_cli::commands::simulate::Args),
+    /// The textbook's single-channel INS/SINS: nonlinear, linear and closed-form errors.
+    Channel(schuler_cli::commands::channel::Args),
+    /// The vertical channel: free, baro-aided, with faults and prediction.
+    Vertical(schuler_cli::commands::vertical::Args),
 }
 
 fn main() -> ExitCode {
@@ -29,6 +33,8 @@ fn main() -> ExitCode {
         Command::Nav(args) => schuler_cli::commands::nav::run(args),
         Command::Demo(args) => schuler_cli::commands::demo::run(args),
         Command::Simulate(args) => schuler_cli::commands::simulate::run(args),
+        Command::Channel(args) => schuler_cli::commands::channel::run(args),
+        Command::Vertical(args) => schuler_cli::commands::vertical::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

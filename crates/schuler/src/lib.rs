@@ -6,6 +6,7 @@
 //! (`v_n = c_bn * v_b`).
 
 pub mod analysis;
+pub mod channel;
 pub mod earth;
 pub mod imu;
 pub mod nav;

@@ -1,6 +1,8 @@
 //! One module per `schuler` subcommand: each parses its arguments and wires library
 //! calls to readers and writers.
 
+pub mod channel;
 pub mod demo;
 pub mod nav;
 pub mod simulate;
+pub mod vertical;

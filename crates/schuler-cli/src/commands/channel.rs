@@ -1,0 +1,463 @@
+//! `schuler channel`: the textbook's single-channel INS or SINS run three ways: the
+//! nonlinear ideal and perturbed systems (6)/(9) or (7)/(26), the linear error model
+//! (13)/(28), and the closed form (18)-(23) where the inputs are constant.
+//!
+//! Writes `errors.csv` (`t,dr,dv,alpha,dr_linear,dv_linear,alpha_linear,dr_closed,
+//! dv_closed,alpha_closed`, SI: s, m, m/s, rad; `_closed` empty without a closed form),
+//! `summary.json` (inputs in SI, measured Schuler period, largest differences, peaks)
+//! and the plots `dr.svg` (km), `dv.svg` (m/s), `alpha.svg` (arcsec), like the text's
+//! figures 4-15. Every value with a unit goes through `schuler::units`.
+
+use crate::plot::{LineStyle, Plot};
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use schuler::channel::ChannelError;
+use schuler::channel::linear::ErrorState;
+use schuler::channel::models::{Alignment, SensorErrors, System};
+use schuler::channel::profile::{BodyAngleProfile, SpeedProfile};
+use schuler::channel::run::{ChannelConfig, ChannelRun, simulate};
+use schuler::earth::Sphere;
+use schuler::units::{self, ARCSEC, DEG, Dimension};
+use serde_json::{Value, json};
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+// ---------------------------------------------------------------------------------------
+// Flag values with units (shared with `schuler vertical`).
+
+fn quantity(s: &str, dim: Dimension) -> Result<f64, String> {
+    units::parse_as(s, dim).map_err(|e| e.to_string())
+}
+
+/// An acceleration with its unit (`1e-3m/s^2`, `100ug`, `1mGal`) in m/s^2.
+pub(crate) fn acceleration(s: &str) -> Result<f64, String> {
+    quantity(s, Dimension::Acceleration)
+}
+
+/// An angular rate with its unit (`0.01deg/h`, `6deg/s`) in rad/s.
+pub(crate) fn angular_rate(s: &str) -> Result<f64, String> {
+    quantity(s, Dimension::AngularRate)
+}
+
+/// An angle with its unit (`20arcsec`, `180deg`) in rad.
+pub(crate) fn angle(s: &str) -> Result<f64, String> {
+    quantity(s, Dimension::Angle)
+}
+
+/// A velocity with its unit (`1m/s`, `250kn`) in m/s.
+pub(crate) fn velocity(s: &str) -> Result<f64, String> {
+    quantity(s, Dimension::Velocity)
+}
+
+/// A length with its unit (`100m`, `6371km`) in m.
+pub(crate) fn length(s: &str) -> Result<f64, String> {
+    quantity(s, Dimension::Length)
+}
+
+/// A time with its unit (`4h`, `0.1s`) in s.
+pub(crate) fn time(s: &str) -> Result<f64, String> {
+    quantity(s, Dimension::Time)
+}
+
+/// A ratio: a bare number or with `ppm`, `ppb`, `%`.
+pub(crate) fn ratio(s: &str) -> Result<f64, String> {
+    units::parse_as_or_si(s, Dimension::Dimensionless).map_err(|e| e.to_string())
+}
+
+/// True for a number > 0 (false for NaN).
+pub(crate) fn is_positive(x: f64) -> bool {
+    x > 0.0
+}
+
+/// `AT:ANGLE[:DURATION]`, e.g. `1h:180deg` or `1h:180deg:20s`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TurnSpec {
+    /// Start \[s\].
+    pub at: f64,
+    /// Angle \[rad\].
+    pub angle: f64,
+    /// Duration \[s\], if given.
+    pub duration: Option<f64>,
+}
+
+fn turn_spec(s: &str) -> Result<TurnSpec, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if !(2..=3).contains(&parts.len()) {
+        return Err(format!(
+            "expected AT:ANGLE[:DURATION] (e.g. 1h:180deg), got {s:?}"
+        ));
+    }
+    Ok(TurnSpec {
+        at: time(parts[0]).map_err(|e| format!("AT: {e}"))?,
+        angle: angle(parts[1]).map_err(|e| format!("ANGLE: {e}"))?,
+        duration: parts
+            .get(2)
+            .map(|d| time(d).map_err(|e| format!("DURATION: {e}")))
+            .transpose()?,
+    })
+}
+
+/// Default turn rate when a `--turn` gives no duration: 30 deg/s on average (peak 60).
+const DEFAULT_TURN_RATE: f64 = 30.0 * DEG;
+
+/// The textbook's Earth rate, used by a bare `--earth-rate`.
+const EARTH_RATE_TEXT: &str = "7.2921158553e-5rad/s";
+
+/// The system modelled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SystemChoice {
+    /// Platform (gimballed) INS, (6) and (9).
+    Ins,
+    /// Strapdown INS, (7) and (26).
+    Sins,
+}
+
+/// Arguments of `schuler channel`. Values carry units (`1e-3m/s^2`, `0.01deg/h`,
+/// `20arcsec`, `4h`); errors are set one at a time, as in the text's figures, or together.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Platform INS or strapdown SINS.
+    #[arg(long, value_enum, default_value = "ins")]
+    pub system: SystemChoice,
+    /// INS: bias of the platform accelerometer (e.g. 1e-3m/s^2).
+    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, value_name = "ACCEL")]
+    pub accel_bias: Option<f64>,
+    /// SINS: bias of the accelerometer on the body vertical p1.
+    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, value_name = "ACCEL")]
+    pub accel_bias_p1: Option<f64>,
+    /// SINS: bias of the accelerometer on the body axis p2.
+    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, value_name = "ACCEL")]
+    pub accel_bias_p2: Option<f64>,
+    /// Gyro drift: platform drift (INS) or gyro bias on p3 (SINS), e.g. 0.01deg/h.
+    #[arg(long, value_parser = angular_rate, allow_hyphen_values = true, value_name = "RATE")]
+    pub gyro_drift: Option<f64>,
+    /// Gyro scale-factor error (1e-5, 10ppm).
+    #[arg(long, value_parser = ratio, allow_hyphen_values = true, value_name = "RATIO")]
+    pub gyro_scale: Option<f64>,
+    /// Initial vertical error alpha0 (e.g. 20arcsec).
+    #[arg(long, value_parser = angle, allow_hyphen_values = true, value_name = "ANGLE", conflicts_with = "level")]
+    pub init_tilt: Option<f64>,
+    /// Initial velocity error (e.g. 1m/s).
+    #[arg(long, value_parser = velocity, allow_hyphen_values = true, value_name = "SPEED")]
+    pub init_vel_error: Option<f64>,
+    /// Initial position error (e.g. 100m).
+    #[arg(long, value_parser = length, allow_hyphen_values = true, value_name = "LENGTH")]
+    pub init_pos_error: Option<f64>,
+    /// Level at t = 0 with the biased sensors, so alpha0 comes out of the model (24).
+    #[arg(long)]
+    pub level: bool,
+    /// Rotate the Earth: bare flag for 7.2921158553e-5 rad/s, or a rate.
+    #[arg(long, value_parser = angular_rate, num_args = 0..=1, default_missing_value = EARTH_RATE_TEXT, value_name = "RATE")]
+    pub earth_rate: Option<f64>,
+    /// SINS: turn the body by ANGLE starting at AT, over DURATION (default |ANGLE| at
+    /// 30 deg/s); repeatable, e.g. --turn 1h:180deg.
+    #[arg(long, value_parser = turn_spec, allow_hyphen_values = true, value_name = "AT:ANGLE[:DURATION]")]
+    pub turn: Vec<TurnSpec>,
+    /// SINS: rotate the body continuously at RATE (e.g. 6deg/s = 1 rev/min).
+    #[arg(long, value_parser = angular_rate, allow_hyphen_values = true, value_name = "RATE")]
+    pub rotate: Option<f64>,
+    /// Constant speed along the equator (e.g. 250m/s); default at rest.
+    #[arg(long, value_parser = velocity, allow_hyphen_values = true, value_name = "SPEED")]
+    pub speed: Option<f64>,
+    /// Run length.
+    #[arg(long, value_parser = time, allow_hyphen_values = true, default_value = "4h", value_name = "TIME")]
+    pub duration: f64,
+    /// Integration step (RK4); default 1 s, or the largest 1/n s that resolves the turns
+    /// (10 steps each) and the rotation (0.1 rad per step).
+    #[arg(long, value_parser = time, allow_hyphen_values = true, value_name = "TIME")]
+    pub dt: Option<f64>,
+    /// Sphere radius a.
+    #[arg(long, value_parser = length, allow_hyphen_values = true, default_value = "6371km", value_name = "LENGTH")]
+    pub radius: f64,
+    /// Gravitation at the surface g.
+    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, default_value = "9.81m/s^2", value_name = "ACCEL")]
+    pub g: f64,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// Builds the library scenario from the flags, naming the flag on any inconsistency.
+pub fn config(args: &Args) -> Result<ChannelConfig> {
+    let system = match args.system {
+        SystemChoice::Ins => System::Ins,
+        SystemChoice::Sins => System::Sins,
+    };
+    if system == System::Ins {
+        for (set, flag) in [
+            (args.accel_bias_p1.is_some(), "--accel-bias-p1"),
+            (args.accel_bias_p2.is_some(), "--accel-bias-p2"),
+            (!args.turn.is_empty(), "--turn"),
+            (args.rotate.is_some(), "--rotate"),
+        ] {
+            if set {
+                bail!(
+                    "{flag} applies to --system sins: the platform INS keeps its accelerometer on a level platform, whatever the body does (6)"
+                );
+            }
+        }
+    } else if args.accel_bias.is_some() {
+        bail!(
+            "--accel-bias is the platform accelerometer's bias (--system ins); for --system sins give --accel-bias-p1 and/or --accel-bias-p2"
+        );
+    }
+    if !is_positive(args.radius) {
+        bail!("--radius must be positive, got {} m", args.radius);
+    }
+    if !is_positive(args.g) {
+        bail!("--g must be positive, got {} m/s^2", args.g);
+    }
+    if !is_positive(args.duration) {
+        bail!("--duration must be positive, got {} s", args.duration);
+    }
+    let earth = Sphere::with_surface_gravity(args.radius, args.g, args.earth_rate.unwrap_or(0.0));
+    let mut body = BodyAngleProfile::fixed(0.0).with_rate(args.rotate.unwrap_or(0.0));
+    for t in &args.turn {
+        let duration = t
+            .duration
+            .unwrap_or_else(|| (t.angle.abs() / DEFAULT_TURN_RATE).max(1.0));
+        if !is_positive(duration) {
+            bail!("--turn: the duration must be positive, got {duration} s");
+        }
+        body = body.with_turn(t.at, duration, t.angle);
+    }
+    let mut cfg = ChannelConfig {
+        system,
+        earth,
+        speed: SpeedProfile::constant(args.speed.unwrap_or(0.0)),
+        body,
+        sensors: SensorErrors {
+            accel_bias: args.accel_bias.unwrap_or(0.0),
+            accel_bias_p1: args.accel_bias_p1.unwrap_or(0.0),
+            accel_bias_p2: args.accel_bias_p2.unwrap_or(0.0),
+            drift: args.gyro_drift.unwrap_or(0.0),
+            gyro_scale: args.gyro_scale.unwrap_or(0.0),
+        },
+        alignment: if args.level {
+            Alignment::Level
+        } else {
+            Alignment::Tilt(args.init_tilt.unwrap_or(0.0))
+        },
+        init_vel_error: args.init_vel_error.unwrap_or(0.0),
+        init_pos_error: args.init_pos_error.unwrap_or(0.0),
+        duration: args.duration,
+        dt: 1.0,
+        record_interval: 1.0,
+    };
+    let (max_dt, _) = cfg.max_step();
+    cfg.dt = match args.dt {
+        Some(dt) if !is_positive(dt) => bail!("--dt must be positive, got {dt} s"),
+        Some(dt) => dt,
+        // The largest step that divides 1 s and resolves the motion, so rows fall on
+        // whole seconds.
+        None => 1.0 / (1.0 / max_dt.min(1.0)).ceil(),
+    };
+    cfg.record_interval = cfg.dt.max(1.0);
+    Ok(cfg)
+}
+
+/// Adds the flag that a library error is about.
+fn explain(e: ChannelError) -> anyhow::Error {
+    let flag = match &e {
+        ChannelError::StepTooCoarse { .. } => Some("--dt"),
+        ChannelError::CannotLevel { .. } => Some("--level"),
+        ChannelError::NonFinite { name, .. }
+        | ChannelError::NotPositive { name, .. }
+        | ChannelError::OutOfRange { name, .. } => match *name {
+            "step dt" => Some("--dt"),
+            "duration" => Some("--duration"),
+            "radius" => Some("--radius"),
+            "gravitational parameter" => Some("--g"),
+            _ => None,
+        },
+        _ => None,
+    };
+    match flag {
+        Some(f) => anyhow::anyhow!("{f}: {e}"),
+        None => anyhow::anyhow!("invalid scenario: {e}"),
+    }
+}
+
+/// `schuler channel`.
+pub fn run(args: Args) -> Result<()> {
+    let cfg = config(&args)?;
+    let result = simulate(&cfg).map_err(explain)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating --out directory {}", args.out.display()))?;
+    write_errors_csv(&args.out.join("errors.csv"), &result)?;
+    let summary = summary(&cfg, &result);
+    let text = serde_json::to_string_pretty(&summary).context("encoding summary.json")?;
+    std::fs::write(args.out.join("summary.json"), text + "\n")
+        .with_context(|| format!("writing {}", args.out.join("summary.json").display()))?;
+    write_plots(&args.out, &cfg, &result)?;
+    let period = summary["schuler_period_s"]["measured"].as_f64();
+    let mut line = format!(
+        "schuler channel: {} over {} s; peak dr {:.3} m, dv {:.4} m/s, alpha {:.3} arcsec",
+        summary["system"].as_str().unwrap_or("?"),
+        cfg.duration,
+        result.peak_nonlinear.dr,
+        result.peak_nonlinear.dv,
+        result.peak_nonlinear.alpha / ARCSEC
+    );
+    if let Some(p) = period {
+        let _ = write!(line, "; Schuler period {:.3} min", p / 60.0);
+    }
+    println!("{line}; wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Writes `errors.csv`.
+fn write_errors_csv(path: &Path, run: &ChannelRun) -> Result<()> {
+    let file =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut w = std::io::BufWriter::new(file);
+    let mut line = String::with_capacity(256);
+    writeln!(
+        w,
+        "t,dr,dv,alpha,dr_linear,dv_linear,alpha_linear,dr_closed,dv_closed,alpha_closed"
+    )?;
+    for r in &run.rows {
+        line.clear();
+        let _ = write!(
+            line,
+            "{},{:e},{:e},{:e},{:e},{:e},{:e}",
+            r.t,
+            r.nonlinear.dr,
+            r.nonlinear.dv,
+            r.nonlinear.alpha,
+            r.linear.dr,
+            r.linear.dv,
+            r.linear.alpha
+        );
+        match r.closed {
+            Some(c) => {
+                let _ = write!(line, ",{:e},{:e},{:e}", c.dr, c.dv, c.alpha);
+            }
+            None => line.push_str(",,,"),
+        }
+        writeln!(w, "{line}")?;
+    }
+    w.flush()
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+fn triple(e: &ErrorState) -> Value {
+    json!({ "dr_m": e.dr, "dv_m_s": e.dv, "alpha_rad": e.alpha })
+}
+
+fn ratio_of(a: &ErrorState, b: &ErrorState) -> Value {
+    let r = |x: f64, y: f64| if y > 0.0 { json!(x / y) } else { Value::Null };
+    json!({ "dr": r(a.dr, b.dr), "dv": r(a.dv, b.dv), "alpha": r(a.alpha, b.alpha) })
+}
+
+/// The summary: inputs in SI, the measured Schuler period and trend, differences, peaks.
+fn summary(cfg: &ChannelConfig, run: &ChannelRun) -> Value {
+    let g = cfg.earth.gravitation(cfg.earth.radius);
+    let theory = std::f64::consts::TAU * (cfg.earth.radius / g).sqrt();
+    let fit = run.measured_oscillation();
+    let measured = fit.map(|f| f.period);
+    let slope_theory = run
+        .constant_errors
+        .map(|c| -run.model.g * c.drift / run.model.schuler_frequency().powi(2));
+    json!({
+        "command": "channel",
+        "system": match cfg.system { System::Ins => "ins", System::Sins => "sins" },
+        "inputs": {
+            "radius_m": cfg.earth.radius,
+            "g_m_s2": g,
+            "earth_rate_rad_s": cfg.earth.rotation_rate,
+            "accel_bias_m_s2": cfg.sensors.accel_bias,
+            "accel_bias_p1_m_s2": cfg.sensors.accel_bias_p1,
+            "accel_bias_p2_m_s2": cfg.sensors.accel_bias_p2,
+            "gyro_drift_rad_s": cfg.sensors.drift,
+            "gyro_scale": cfg.sensors.gyro_scale,
+            "init_tilt_rad": match cfg.alignment { Alignment::Tilt(a) => json!(a), Alignment::Level => Value::Null },
+            "level": matches!(cfg.alignment, Alignment::Level),
+            "init_vel_error_m_s": cfg.init_vel_error,
+            "init_pos_error_m": cfg.init_pos_error,
+            "speed_m_s": cfg.speed.initial,
+            "rotate_rad_s": cfg.body.rate,
+            "turns": cfg.body.turns.iter().map(|t| json!({"at_s": t.start, "angle_rad": t.angle, "duration_s": t.duration})).collect::<Vec<_>>(),
+            "duration_s": cfg.duration,
+            "dt_s": cfg.dt,
+        },
+        "alpha0_rad": { "nonlinear": run.alpha0_nonlinear, "linear": run.alpha0_linear },
+        "linear_model_g_m_s2": run.model.g,
+        "schuler_period_s": {
+            "theory": theory,
+            "theory_linear_model": run.model.schuler_period(),
+            "measured": measured,
+            "relative_error": measured.map(|m| m / theory - 1.0),
+        },
+        "position_slope_m_s": {
+            "measured": run.measured_position_slope(),
+            "theory": slope_theory,
+        },
+        "closed_form": run.constant_errors.map(|_| "(18)-(19)"),
+        "max_abs_diff": {
+            "nonlinear_minus_linear": triple(&run.max_nonlinear_minus_linear),
+            "linear_minus_closed": run.max_linear_minus_closed.as_ref().map(triple),
+        },
+        "relative_to_peak": {
+            "nonlinear_minus_linear": ratio_of(&run.max_nonlinear_minus_linear, &run.peak_linear),
+            "linear_minus_closed": run.max_linear_minus_closed.as_ref().zip(run.peak_closed.as_ref()).map(|(d, p)| ratio_of(d, p)),
+        },
+        "peak": {
+            "nonlinear": triple(&run.peak_nonlinear),
+            "linear": triple(&run.peak_linear),
+            "closed": run.peak_closed.as_ref().map(triple),
+        },
+        "files": ["errors.csv", "summary.json", "dr.svg", "dv.svg", "alpha.svg"],
+    })
+}
+
+/// Time axis: hours for runs of 2 h or more, minutes from 10 min, else seconds.
+pub(crate) fn time_axis(duration: f64) -> (f64, &'static str) {
+    if duration >= 7200.0 {
+        (3600.0, "t [h]")
+    } else if duration >= 600.0 {
+        (60.0, "t [min]")
+    } else {
+        (1.0, "t [s]")
+    }
+}
+
+/// Writes `dr.svg`, `dv.svg`, `alpha.svg`.
+fn write_plots(dir: &Path, cfg: &ChannelConfig, run: &ChannelRun) -> Result<()> {
+    let (tscale, tlabel) = time_axis(cfg.duration);
+    let t: Vec<f64> = run.rows.iter().map(|r| r.t / tscale).collect();
+    let sys = match cfg.system {
+        System::Ins => "INS",
+        System::Sins => "SINS",
+    };
+    type Pick = fn(&ErrorState) -> f64;
+    let panels: [(&str, &str, &str, f64, Pick); 3] = [
+        ("dr.svg", "Position error", "dr [km]", 1e3, |e| e.dr),
+        ("dv.svg", "Velocity error", "dV [m/s]", 1.0, |e| e.dv),
+        (
+            "alpha.svg",
+            "Vertical error",
+            "alpha [arcsec]",
+            ARCSEC,
+            |e| e.alpha,
+        ),
+    ];
+    for (file, title, ylabel, unit, pick) in panels {
+        let nl: Vec<f64> = run.rows.iter().map(|r| pick(&r.nonlinear) / unit).collect();
+        let lin: Vec<f64> = run.rows.iter().map(|r| pick(&r.linear) / unit).collect();
+        let mut plot = Plot::new(&format!("Single-channel {sys}: {title}"), tlabel, ylabel)
+            .line("nonlinear (9)/(26)", &t, &nl, LineStyle::Solid)
+            .line("linear (13)/(28)", &t, &lin, LineStyle::Dashed);
+        if run.constant_errors.is_some() {
+            let closed: Vec<Option<f64>> = run
+                .rows
+                .iter()
+                .map(|r| r.closed.map(|c| pick(&c) / unit))
+                .collect();
+            plot = plot.line_opt("closed form (18)-(19)", &t, &closed, LineStyle::Dotted);
+        }
+        plot.write(&dir.join(file))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,490 @@
+//! Small self-contained SVG line plots: several series, a title, axis labels with units,
+//! a legend, and optional shaded x-intervals (e.g. periods of prediction).
+//!
+//! No dependencies and no fonts to bundle: the SVG names a generic sans-serif family and
+//! any browser or viewer renders it. Long series are thinned per pixel column keeping
+//! each column's first, lowest, highest and last point, so envelopes survive. Non-finite
+//! values break a line instead of corrupting it.
+//!
+//! ```
+//! use schuler_cli::plot::{LineStyle, Plot};
+//! let t = [0.0, 1.0, 2.0];
+//! let svg = Plot::new("Velocity error", "t [h]", "dV [m/s]")
+//!     .line("nonlinear", &t, &[0.0, 0.5, 0.2], LineStyle::Solid)
+//!     .line("closed form", &t, &[0.0, 0.49, 0.21], LineStyle::Dashed)
+//!     .to_svg();
+//! assert!(svg.starts_with("<svg") && svg.contains("dV [m/s]"));
+//! ```
+
+use anyhow::{Context, Result};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// How a series is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LineStyle {
+    /// Continuous line.
+    Solid,
+    /// Long dashes.
+    Dashed,
+    /// Dots.
+    Dotted,
+}
+
+impl LineStyle {
+    fn dasharray(self) -> Option<&'static str> {
+        match self {
+            LineStyle::Solid => None,
+            LineStyle::Dashed => Some("8 5"),
+            LineStyle::Dotted => Some("2 4"),
+        }
+    }
+}
+
+/// One named series of (x, y) points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend text.
+    pub label: String,
+    /// Points in data units.
+    pub points: Vec<(f64, f64)>,
+    /// Stroke style.
+    pub style: LineStyle,
+}
+
+/// A shaded x-interval with a legend entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Span {
+    /// Start (x units).
+    pub from: f64,
+    /// End (x units).
+    pub to: f64,
+}
+
+/// A line plot under construction; [`Plot::to_svg`] renders it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plot {
+    /// Title above the plot.
+    pub title: String,
+    /// X-axis label, with unit (e.g. `"t [h]"`).
+    pub x_label: String,
+    /// Y-axis label, with unit (e.g. `"alpha [arcsec]"`).
+    pub y_label: String,
+    /// The series, drawn in order.
+    pub series: Vec<Series>,
+    /// Shaded x-intervals.
+    pub spans: Vec<Span>,
+    /// Legend label of the shaded intervals.
+    pub span_label: String,
+    /// Width \[px\].
+    pub width: u32,
+    /// Height \[px\].
+    pub height: u32,
+}
+
+const PALETTE: [&str; 6] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
+];
+const LEFT: f64 = 84.0;
+const RIGHT: f64 = 20.0;
+const TOP: f64 = 40.0;
+const BOTTOM: f64 = 56.0;
+
+impl Plot {
+    /// An empty 800x480 plot.
+    pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
+        Self {
+            title: title.to_owned(),
+            x_label: x_label.to_owned(),
+            y_label: y_label.to_owned(),
+            series: Vec::new(),
+            spans: Vec::new(),
+            span_label: String::new(),
+            width: 800,
+            height: 480,
+        }
+    }
+
+    /// Adds a series from parallel slices (extra elements of the longer one are ignored).
+    pub fn line(mut self, label: &str, x: &[f64], y: &[f64], style: LineStyle) -> Self {
+        self.series.push(Series {
+            label: label.to_owned(),
+            points: x.iter().copied().zip(y.iter().copied()).collect(),
+            style,
+        });
+        self
+    }
+
+    /// Adds a series from optional values: `None` leaves a gap.
+    pub fn line_opt(mut self, label: &str, x: &[f64], y: &[Option<f64>], style: LineStyle) -> Self {
+        self.series.push(Series {
+            label: label.to_owned(),
+            points: x
+                .iter()
+                .zip(y)
+                .map(|(&x, y)| (x, y.unwrap_or(f64::NAN)))
+                .collect(),
+            style,
+        });
+        self
+    }
+
+    /// Shades the x-intervals `spans`, listed once in the legend as `label`.
+    pub fn shade(mut self, label: &str, spans: impl IntoIterator<Item = (f64, f64)>) -> Self {
+        self.span_label = label.to_owned();
+        self.spans
+            .extend(spans.into_iter().map(|(from, to)| Span { from, to }));
+        self
+    }
+
+    /// Writes the SVG to `path`.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        std::fs::write(path, self.to_svg()).with_context(|| format!("writing {}", path.display()))
+    }
+
+    /// Renders the plot as a standalone SVG document.
+    pub fn to_svg(&self) -> String {
+        let (w, h) = (f64::from(self.width), f64::from(self.height));
+        let (pw, ph) = (w - LEFT - RIGHT, h - TOP - BOTTOM);
+        let finite = self
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|(x, y)| x.is_finite() && y.is_finite());
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for &(x, y) in finite {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        let (x0, x1) = widen(x0, x1, 0.0);
+        let (y0, y1) = widen(y0, y1, 0.05);
+        let xt = ticks(x0, x1, 8);
+        let yt = ticks(y0, y1, 7);
+        let (x0, x1) = (x0.min(xt[0]), x1.max(*xt.last().unwrap_or(&x1)));
+        let (y0, y1) = (y0.min(yt[0]), y1.max(*yt.last().unwrap_or(&y1)));
+        let sx = |x: f64| LEFT + (x - x0) / (x1 - x0) * pw;
+        let sy = |y: f64| TOP + (y1 - y) / (y1 - y0) * ph;
+
+        let mut s = String::with_capacity(64 * 1024);
+        let _ = writeln!(
+            s,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
+        );
+        let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="24" text-anchor="middle" font-size="15">{}</text>"#,
+            LEFT + pw / 2.0,
+            esc(&self.title)
+        );
+        // Shaded spans, clipped to the plot area.
+        for span in &self.spans {
+            let (a, b) = (sx(span.from.max(x0)), sx(span.to.min(x1)));
+            if b > a {
+                let _ = writeln!(
+                    s,
+                    r##"<rect x="{a:.1}" y="{TOP}" width="{:.1}" height="{ph}" fill="#999999" fill-opacity="0.18"/>"##,
+                    b - a
+                );
+            }
+        }
+        // Grid and tick labels.
+        for &v in &xt {
+            let x = sx(v);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{}" stroke="#e0e0e0"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
+                TOP + ph,
+                TOP + ph + 16.0,
+                label(v, &xt)
+            );
+        }
+        for &v in &yt {
+            let y = sy(v);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{LEFT}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#e0e0e0"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+                LEFT + pw,
+                LEFT - 6.0,
+                y + 4.0,
+                label(v, &yt)
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<rect x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+            LEFT + pw / 2.0,
+            h - 12.0,
+            esc(&self.x_label)
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{}</text>"#,
+            TOP + ph / 2.0,
+            TOP + ph / 2.0,
+            esc(&self.y_label)
+        );
+        // Series.
+        for (i, series) in self.series.iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            let dash = series
+                .style
+                .dasharray()
+                .map(|d| format!(r#" stroke-dasharray="{d}""#))
+                .unwrap_or_default();
+            for run in thin(&series.points, x0, x1, pw as usize) {
+                if run.len() == 1 {
+                    let (x, y) = run[0];
+                    let _ = writeln!(
+                        s,
+                        r#"<circle cx="{:.2}" cy="{:.2}" r="1.5" fill="{color}"/>"#,
+                        sx(x),
+                        sy(y)
+                    );
+                    continue;
+                }
+                let _ = write!(
+                    s,
+                    r#"<polyline fill="none" stroke="{color}" stroke-width="1.6"{dash} points=""#
+                );
+                for (x, y) in run {
+                    let _ = write!(s, "{:.2},{:.2} ", sx(x), sy(y));
+                }
+                let _ = writeln!(s, r#""/>"#);
+            }
+        }
+        // Legend, top right inside the frame.
+        let mut entries: Vec<(String, String)> = self
+            .series
+            .iter()
+            .enumerate()
+            .map(|(i, se)| {
+                let color = PALETTE[i % PALETTE.len()];
+                let dash = se
+                    .style
+                    .dasharray()
+                    .map(|d| format!(r#" stroke-dasharray="{d}""#))
+                    .unwrap_or_default();
+                (
+                    se.label.clone(),
+                    format!(r#"stroke="{color}" stroke-width="2"{dash}"#),
+                )
+            })
+            .collect();
+        if !self.spans.is_empty() && !self.span_label.is_empty() {
+            entries.push((self.span_label.clone(), String::new()));
+        }
+        if !entries.is_empty() {
+            let longest = entries
+                .iter()
+                .map(|e| e.0.chars().count())
+                .max()
+                .unwrap_or(0) as f64;
+            let bw = 40.0 + 7.0 * longest;
+            let bh = 8.0 + 18.0 * entries.len() as f64;
+            let bx = LEFT + pw - bw - 8.0;
+            let by = TOP + 8.0;
+            let _ = writeln!(
+                s,
+                r##"<rect x="{bx:.1}" y="{by:.1}" width="{bw:.1}" height="{bh:.1}" fill="white" fill-opacity="0.9" stroke="#888888"/>"##
+            );
+            for (k, (text, stroke)) in entries.iter().enumerate() {
+                let y = by + 16.0 + 18.0 * k as f64;
+                if stroke.is_empty() {
+                    let _ = writeln!(
+                        s,
+                        r##"<rect x="{:.1}" y="{:.1}" width="24" height="10" fill="#999999" fill-opacity="0.3"/>"##,
+                        bx + 8.0,
+                        y - 8.0
+                    );
+                } else {
+                    let _ = writeln!(
+                        s,
+                        r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" {stroke}/>"#,
+                        bx + 8.0,
+                        y - 4.0,
+                        bx + 32.0,
+                        y - 4.0
+                    );
+                }
+                let _ = writeln!(
+                    s,
+                    r#"<text x="{:.1}" y="{y:.1}">{}</text>"#,
+                    bx + 38.0,
+                    esc(text)
+                );
+            }
+        }
+        s.push_str("</svg>\n");
+        s
+    }
+}
+
+/// A non-degenerate range: equal ends are widened by 1 (or 10 % of the value); empty
+/// ranges become [0, 1]; `pad` widens by that fraction on both sides.
+fn widen(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    if hi <= lo {
+        let d = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+        return (lo - d, hi + d);
+    }
+    let d = (hi - lo) * pad;
+    (lo - d, hi + d)
+}
+
+/// About `target` round tick values (1, 2, 5 times a power of ten) covering [lo, hi].
+pub fn ticks(lo: f64, hi: f64, target: usize) -> Vec<f64> {
+    let raw = (hi - lo) / target.max(1) as f64;
+    if !(raw.is_finite() && raw > 0.0) {
+        return vec![lo, hi];
+    }
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let first = (lo / step).floor() as i64;
+    let last = (hi / step).ceil() as i64;
+    (first..=last).map(|k| k as f64 * step).collect()
+}
+
+/// Tick label with as many decimals as the tick step needs; exponent form for very
+/// large or small magnitudes.
+fn label(v: f64, all: &[f64]) -> String {
+    let step = if all.len() > 1 {
+        (all[1] - all[0]).abs()
+    } else {
+        1.0
+    };
+    let big = all.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if v == 0.0 {
+        return "0".to_owned();
+    }
+    if !(1e-3..1e6).contains(&big) {
+        let digits = ((big / step).log10().ceil().max(1.0) as usize).min(6);
+        return format!("{:.*e}", digits.saturating_sub(1), v);
+    }
+    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// Splits a series at non-finite points into runs and thins each run to at most four
+/// points per pixel column (first, min, max, last, in x order).
+fn thin(points: &[(f64, f64)], x0: f64, x1: f64, columns: usize) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    for &(x, y) in points {
+        if x.is_finite() && y.is_finite() {
+            cur.push((x, y));
+        } else if !cur.is_empty() {
+            runs.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        runs.push(cur);
+    }
+    let columns = columns.max(1);
+    runs.into_iter()
+        .map(|run| {
+            if run.len() <= 4 * columns {
+                return run;
+            }
+            let col = |x: f64| (((x - x0) / (x1 - x0)) * columns as f64).floor() as i64;
+            let mut out = Vec::with_capacity(4 * columns);
+            let mut start = 0;
+            while start < run.len() {
+                let c = col(run[start].0);
+                let mut end = start;
+                while end < run.len() && col(run[end].0) == c {
+                    end += 1;
+                }
+                let bucket = &run[start..end];
+                let (mut imin, mut imax) = (0, 0);
+                for (i, p) in bucket.iter().enumerate() {
+                    if p.1 < bucket[imin].1 {
+                        imin = i;
+                    }
+                    if p.1 > bucket[imax].1 {
+                        imax = i;
+                    }
+                }
+                let mut keep = vec![0, imin, imax, bucket.len() - 1];
+                keep.sort_unstable();
+                keep.dedup();
+                out.extend(keep.into_iter().map(|i| bucket[i]));
+                start = end;
+            }
+            out
+        })
+        .collect()
+}
+
+/// Escapes text for SVG.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_are_round_and_cover_the_range() {
+        let t = ticks(-0.013, 0.87, 7);
+        assert!(t[0] <= -0.013 && *t.last().unwrap() >= 0.87);
+        let step = t[1] - t[0];
+        assert!((step - 0.2).abs() < 1e-12, "{t:?}");
+    }
+
+    #[test]
+    fn long_series_are_thinned_but_keep_extremes() {
+        let pts: Vec<(f64, f64)> = (0..100_000)
+            .map(|k| {
+                (
+                    k as f64,
+                    if k == 51_234 {
+                        1e3
+                    } else {
+                        (k as f64 * 0.01).sin()
+                    },
+                )
+            })
+            .collect();
+        let runs = thin(&pts, 0.0, 99_999.0, 700);
+        assert_eq!(runs.len(), 1);
+        assert!(runs[0].len() <= 2800);
+        assert!(runs[0].iter().any(|p| p.1 == 1e3));
+    }
+
+    #[test]
+    fn nan_breaks_the_line_and_labels_are_escaped() {
+        let svg = Plot::new("a < b & c", "t [s]", "x [m]")
+            .line(
+                "s",
+                &[0.0, 1.0, 2.0, 3.0, 4.0],
+                &[0.0, 1.0, f64::NAN, 2.0, 3.0],
+                LineStyle::Dotted,
+            )
+            .shade("predict", [(1.0, 2.0)])
+            .to_svg();
+        assert_eq!(svg.matches("<polyline").count(), 2);
+        assert!(svg.contains("a &lt; b &amp; c"));
+        assert!(svg.contains("predict"));
+    }
+}
