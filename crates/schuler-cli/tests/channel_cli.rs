@@ -174,3 +174,32 @@ fn bad_flags_name_the_flag_and_the_reason() {
         &["--level", "cannot level"],
     );
 }
+
+/// `--accelerate`: a platform INS leveled with a 1e-3 m/s^2 accelerometer bias keeps
+/// its position error at the text's neglected term while the vehicle speeds up to
+/// 100 m/s: the leveling cancels the bias (alpha0 = df/g) and what remains is
+/// 2 V^2 df / g^2 = 0.208 m from the a lambda'^2 part of the specific force (the
+/// unleveled error would be 2 df/w0^2 = 1299 m).
+#[test]
+fn leveled_ins_stays_put_through_an_acceleration() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    channel(
+        dir.path(),
+        &[
+            "--system",
+            "ins",
+            "--accel-bias",
+            "1e-3m/s^2",
+            "--level",
+            "--accelerate",
+            "10min:100m/s:50s",
+            "--duration",
+            "2h",
+        ],
+    )
+    .success();
+    let s = summary(dir.path());
+    let peak = s["peak"]["nonlinear"]["dr_m"].as_f64().expect("peak dr");
+    let bound = 2.0 * 100.0f64.powi(2) * 1e-3 / 9.81f64.powi(2);
+    assert!(peak <= 1.01 * bound, "{peak} m vs {bound} m");
+}

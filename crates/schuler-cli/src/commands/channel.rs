@@ -98,6 +98,31 @@ fn turn_spec(s: &str) -> Result<TurnSpec, String> {
     })
 }
 
+/// A speed change `AT:DV:DURATION` along the track.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccelSpec {
+    /// Start \[s\].
+    pub at: f64,
+    /// Speed change \[m/s\].
+    pub delta_v: f64,
+    /// Duration \[s\].
+    pub duration: f64,
+}
+
+fn accel_spec(s: &str) -> Result<AccelSpec, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected AT:DV:DURATION (e.g. 10min:100m/s:50s), got {s:?}"
+        ));
+    }
+    Ok(AccelSpec {
+        at: time(parts[0]).map_err(|e| format!("AT: {e}"))?,
+        delta_v: velocity(parts[1]).map_err(|e| format!("DV: {e}"))?,
+        duration: time(parts[2]).map_err(|e| format!("DURATION: {e}"))?,
+    })
+}
+
 /// Default turn rate when a `--turn` gives no duration: 30 deg/s on average (peak 60).
 const DEFAULT_TURN_RATE: f64 = 30.0 * DEG;
 
@@ -160,6 +185,10 @@ pub struct Args {
     /// Constant speed along the equator (e.g. 250m/s); default at rest.
     #[arg(long, value_parser = velocity, allow_hyphen_values = true, value_name = "SPEED")]
     pub speed: Option<f64>,
+    /// Change speed by DV starting at AT over DURATION (smooth acceleration profile);
+    /// repeatable, e.g. --accelerate 10min:100m/s:50s.
+    #[arg(long, value_parser = accel_spec, allow_hyphen_values = true, value_name = "AT:DV:DURATION")]
+    pub accelerate: Vec<AccelSpec>,
     /// Run length.
     #[arg(long, value_parser = time, allow_hyphen_values = true, default_value = "4h", value_name = "TIME")]
     pub duration: f64,
@@ -222,10 +251,20 @@ pub fn config(args: &Args) -> Result<ChannelConfig> {
         }
         body = body.with_turn(t.at, duration, t.angle);
     }
+    let mut speed = SpeedProfile::constant(args.speed.unwrap_or(0.0));
+    for a in &args.accelerate {
+        if !is_positive(a.duration) {
+            bail!(
+                "--accelerate: the duration must be positive, got {} s",
+                a.duration
+            );
+        }
+        speed = speed.with_change(a.at, a.duration, a.delta_v);
+    }
     let mut cfg = ChannelConfig {
         system,
         earth,
-        speed: SpeedProfile::constant(args.speed.unwrap_or(0.0)),
+        speed,
         body,
         sensors: SensorErrors {
             accel_bias: args.accel_bias.unwrap_or(0.0),
