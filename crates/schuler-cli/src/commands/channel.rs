@@ -196,15 +196,36 @@ pub struct Args {
     /// (10 steps each) and the rotation (0.1 rad per step).
     #[arg(long, value_parser = time, allow_hyphen_values = true, value_name = "TIME")]
     pub dt: Option<f64>,
+    /// The textbook sphere.
+    #[command(flatten)]
+    pub sphere: SphereArgs,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// The textbook sphere's radius and surface gravitation (shared with `schuler vertical`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct SphereArgs {
     /// Sphere radius a.
     #[arg(long, value_parser = length, allow_hyphen_values = true, default_value = "6371km", value_name = "LENGTH")]
     pub radius: f64,
     /// Gravitation at the surface g.
     #[arg(long, value_parser = acceleration, allow_hyphen_values = true, default_value = "9.81m/s^2", value_name = "ACCEL")]
     pub g: f64,
-    /// Output directory (created if missing).
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
+}
+
+impl SphereArgs {
+    /// The sphere rotating at `rate`, after checking both values are positive.
+    pub fn sphere(&self, rate: f64) -> Result<Sphere> {
+        if !is_positive(self.radius) {
+            bail!("--radius must be positive, got {} m", self.radius);
+        }
+        if !is_positive(self.g) {
+            bail!("--g must be positive, got {} m/s^2", self.g);
+        }
+        Ok(Sphere::with_surface_gravity(self.radius, self.g, rate))
+    }
 }
 
 /// Builds the library scenario from the flags, naming the flag on any inconsistency.
@@ -231,16 +252,7 @@ pub fn config(args: &Args) -> Result<ChannelConfig> {
             "--accel-bias is the platform accelerometer's bias (--system ins); for --system sins give --accel-bias-p1 and/or --accel-bias-p2"
         );
     }
-    if !is_positive(args.radius) {
-        bail!("--radius must be positive, got {} m", args.radius);
-    }
-    if !is_positive(args.g) {
-        bail!("--g must be positive, got {} m/s^2", args.g);
-    }
-    if !is_positive(args.duration) {
-        bail!("--duration must be positive, got {} s", args.duration);
-    }
-    let earth = Sphere::with_surface_gravity(args.radius, args.g, args.earth_rate.unwrap_or(0.0));
+    let earth = args.sphere.sphere(args.earth_rate.unwrap_or(0.0))?;
     let mut body = BodyAngleProfile::fixed(0.0).with_rate(args.rotate.unwrap_or(0.0));
     for t in &args.turn {
         let duration = t

@@ -11,7 +11,7 @@
 //! (eigenvalues, e-fold time, settling and reconvergence times, detector counts) and the
 //! plots `dh.svg`, `dvh.svg`.
 
-use super::channel::{acceleration, is_positive, length, time, time_axis, velocity};
+use super::channel::{SphereArgs, acceleration, is_positive, length, time, time_axis, velocity};
 use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
@@ -25,7 +25,6 @@ use schuler::channel::vertical::{
     AidedRun, Gains, Mode, VerticalConfig, VerticalSample, closed_loop_response, outages,
     simulate_aided, simulate_free,
 };
-use schuler::earth::Sphere;
 use schuler::units::{self, Dimension};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
@@ -155,12 +154,9 @@ pub struct Args {
     /// Integration step and reference sample interval.
     #[arg(long, value_parser = time, allow_hyphen_values = true, default_value = "0.1s", value_name = "TIME")]
     pub dt: f64,
-    /// Sphere radius a.
-    #[arg(long, value_parser = length, allow_hyphen_values = true, default_value = "6371km", value_name = "LENGTH")]
-    pub radius: f64,
-    /// Gravitation at the surface g.
-    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, default_value = "9.81m/s^2", value_name = "ACCEL")]
-    pub g: f64,
+    /// The textbook sphere.
+    #[command(flatten)]
+    pub sphere: SphereArgs,
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -205,12 +201,6 @@ fn explain(e: ChannelError) -> anyhow::Error {
 
 /// `schuler vertical`.
 pub fn run(args: Args) -> Result<()> {
-    if !is_positive(args.radius) {
-        bail!("--radius must be positive, got {} m", args.radius);
-    }
-    if !is_positive(args.g) {
-        bail!("--g must be positive, got {} m/s^2", args.g);
-    }
     if args.ref_noise < 0.0 || args.ref_noise.is_nan() {
         bail!("--ref-noise must be >= 0, got {} m", args.ref_noise);
     }
@@ -221,7 +211,7 @@ pub fn run(args: Args) -> Result<()> {
         bail!("--reacquire must be at least 1");
     }
     let cfg = VerticalConfig {
-        earth: Sphere::with_surface_gravity(args.radius, args.g, 0.0),
+        earth: args.sphere.sphere(0.0)?,
         height: args.height,
         init_height_error: args.init_height_error,
         init_vel_error: args.init_vel_error,
