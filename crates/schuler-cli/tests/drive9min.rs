@@ -7,27 +7,19 @@ use schuler::rotation::Euler;
 use schuler_cli::commands::nav::{EarthChoice, NavSettings, navigate};
 use schuler_cli::formats::{ImuReadOptions, ImuReader};
 use schuler_cli::output::NavWriter;
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-fn data_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/drive9min");
-    assert!(
-        dir.is_dir(),
-        "{} is missing: the shared data sets live beside the checkout",
-        dir.display()
-    );
-    dir
-}
-
 /// Decompress `name.xz` from the data set into `dir/name`.
 fn unpack(dir: &Path, name: &str) -> PathBuf {
-    let src = data_dir().join(format!("{name}.xz"));
-    let mut input = std::io::BufReader::new(std::fs::File::open(&src).expect("open .xz"));
-    let mut out = Vec::new();
-    lzma_rs::xz_decompress(&mut input, &mut out).expect("xz");
     let dst = dir.join(name);
-    std::fs::write(&dst, out).expect("write");
+    std::fs::write(
+        &dst,
+        common::unxz(&common::shared_data("drive9min").join(format!("{name}.xz"))),
+    )
+    .expect("write");
     dst
 }
 
@@ -41,26 +33,14 @@ struct Errors {
     epochs: usize,
 }
 
-fn parse_rows(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .expect("read")
-        .lines()
-        .map(|l| {
-            l.split_whitespace()
-                .map(|x| x.parse().expect("number"))
-                .collect()
-        })
-        .collect()
-}
-
 fn errors(nav: &Path, truth: &Path) -> Errors {
-    let truth_rows = parse_rows(truth);
+    let truth_rows = common::read_rows(truth);
     let by_time: HashMap<i64, &Vec<f64>> = truth_rows
         .iter()
         .map(|r| ((r[1] * 100.0).round() as i64, r))
         .collect();
     let (mut sum2, mut hmax, mut vmax, mut amax, mut n) = (0.0, 0.0f64, 0.0f64, 0.0f64, 0);
-    for r in parse_rows(nav) {
+    for r in common::read_rows(nav) {
         let t = by_time[&((r[1] * 100.0).round() as i64)];
         let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
         let radii = Wgs84.radii(truth.lat);

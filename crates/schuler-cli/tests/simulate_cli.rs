@@ -1,6 +1,8 @@
 //! `schuler simulate` end to end: perfect sensors round-trip through `schuler nav`,
 //! same seed gives the same bytes, bad scenarios name the key.
 
+mod common;
+
 use assert_cmd::Command;
 use predicates::prelude::*;
 use std::path::Path;
@@ -71,23 +73,12 @@ fn schuler() -> Command {
 /// Largest horizontal distance [m] between nav.txt and truth.nav epochs of equal time
 /// (both KF-GINS format, 200 Hz).
 fn max_horizontal_error(nav: &Path, truth: &Path) -> (f64, usize) {
-    let rows = |p: &Path| -> Vec<Vec<f64>> {
-        std::fs::read_to_string(p)
-            .expect("read")
-            .lines()
-            .map(|l| {
-                l.split_whitespace()
-                    .map(|x| x.parse().expect("number"))
-                    .collect()
-            })
-            .collect()
-    };
-    let truth: std::collections::HashMap<i64, Vec<f64>> = rows(truth)
+    let truth: std::collections::HashMap<i64, Vec<f64>> = common::read_rows(truth)
         .into_iter()
         .map(|r| ((r[1] * 200.0).round() as i64, r))
         .collect();
     let (mut worst, mut n) = (0.0f64, 0);
-    for r in rows(nav) {
+    for r in common::read_rows(nav) {
         let t = &truth[&((r[1] * 200.0).round() as i64)];
         let lat = t[2].to_radians();
         // Spherical radius is enough to turn a sub-metre difference into metres.
@@ -257,8 +248,7 @@ fn bad_scenarios_name_the_key() {
 /// body/NED mix-up, would show hundreds of metres and tens of degrees).
 #[test]
 fn gnss_ins_sim_motion_file_follows_its_truth() {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/drive9min");
-    assert!(data.is_dir(), "{} is missing", data.display());
+    let data = common::shared_data("drive9min");
     let dir = tempfile::tempdir().expect("tempdir");
     std::fs::copy(data.join("motion.csv"), dir.path().join("motion.csv")).expect("copy");
     let cfg = scenario(
@@ -274,17 +264,10 @@ fn gnss_ins_sim_motion_file_follows_its_truth() {
         .arg(&out)
         .assert()
         .success();
-    let mut xz =
-        std::io::BufReader::new(std::fs::File::open(data.join("truth.nav.xz")).expect("truth"));
-    let mut truth = Vec::new();
-    lzma_rs::xz_decompress(&mut xz, &mut truth).expect("xz");
+    let truth = common::unxz(&data.join("truth.nav.xz"));
     let parse = |text: &str| -> std::collections::HashMap<i64, Vec<f64>> {
-        text.lines()
-            .map(|l| {
-                l.split_whitespace()
-                    .map(|x| x.parse().expect("number"))
-                    .collect::<Vec<f64>>()
-            })
+        common::rows(text)
+            .into_iter()
             .map(|r| ((r[1] * 100.0).round() as i64, r))
             .collect()
     };
