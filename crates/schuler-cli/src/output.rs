@@ -3,10 +3,20 @@
 //!
 //! KF-GINS navigation result, one epoch per line, space separated:
 //! `week sow lat[deg] lon[deg] h[m] vn ve vd[m/s] roll pitch yaw[deg]`. We write yaw in
-//! [0, 360) (the convention of the awesome-gins-datasets truth files) and longitude in
-//! (-180, 180].
+//! [0, 360) (the convention of the awesome-gins-datasets truth files), longitude in
+//! (-180, 180] and latitude in [-90, 90] (a state carried past a pole is written as
+//! the equivalent point on the opposite meridian, [`NavState::normalized`]), so the
+//! file stays valid over the poles.
+//!
+//! `nav.csv` has the same columns after `t_sow` and, from a writer made with
+//! [`NavWriter::create_extended`] (as `schuler nav` does), four more that are defined
+//! everywhere, poles included: the ECEF position `x_ecef_m, y_ecef_m, z_ecef_m` and
+//! the wander azimuth `wander_azimuth_deg` (angle of the navigation frame's x axis
+//! east of north; 0 for the NED mechanization).
 
 use anyhow::{Context, Result};
+use nalgebra::Vector3;
+use schuler::earth::{EarthModel, Geodetic};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use std::fs::File;
@@ -40,7 +50,7 @@ pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
     }
 }
 
-/// Longitude wrapped to (-180, 180] degrees.
+/// Longitude (or any angle) wrapped to (-180, 180] degrees.
 fn wrap_lon_deg(lon_rad: f64) -> f64 {
     let d = lon_rad.to_degrees();
     let w = (d + 180.0).rem_euclid(360.0) - 180.0;
@@ -60,6 +70,7 @@ struct Row {
 
 impl Row {
     fn of(s: &NavState) -> Self {
+        let s = &s.normalized();
         let e = s.euler();
         Self {
             lat_deg: s.pos.lat.to_degrees(),
@@ -94,6 +105,30 @@ impl Row {
     }
 }
 
+/// One navigation epoch with the quantities defined everywhere (poles included).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NavEpoch {
+    /// The NED state (at a pole relative to the mechanization's pole meridian).
+    pub state: NavState,
+    /// ECEF position [m].
+    pub r_e: Vector3<f64>,
+    /// Wander azimuth [rad]: the navigation frame's x axis east of north (0 in NED).
+    pub wander_azimuth: f64,
+}
+
+/// ECEF position of a geodetic position on the ellipsoid (`a`, `e²`), as
+/// [`EarthModel::geodetic_to_ecef`].
+fn ecef_of(p: &Geodetic, a: f64, e2: f64) -> Vector3<f64> {
+    let (sl, cl) = p.lat.sin_cos();
+    let (so, co) = p.lon.sin_cos();
+    let rn = a / (1.0 - e2 * sl * sl).sqrt();
+    Vector3::new(
+        (rn + p.h) * cl * co,
+        (rn + p.h) * cl * so,
+        (rn * (1.0 - e2) + p.h) * sl,
+    )
+}
+
 /// Writes `nav.txt` (KF-GINS) and `nav.csv` side by side.
 pub struct NavWriter {
     txt: BufWriter<File>,
@@ -103,15 +138,35 @@ pub struct NavWriter {
     week: u32,
     line: Vec<u8>,
     rows: u64,
+    /// Ellipsoid `(a, e²)` when the CSV has the ECEF and wander-azimuth columns.
+    extended: Option<(f64, f64)>,
 }
 
-/// Header of `nav.csv`.
+/// Header of `nav.csv` from [`NavWriter::create`].
 pub const CSV_HEADER: &str =
     "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg";
 
+/// Header of `nav.csv` from [`NavWriter::create_extended`]: [`CSV_HEADER`], then
+/// ECEF position and wander azimuth.
+pub const CSV_HEADER_EXTENDED: &str = "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,\
+     roll_deg,pitch_deg,yaw_deg,x_ecef_m,y_ecef_m,z_ecef_m,wander_azimuth_deg";
+
 impl NavWriter {
-    /// Create `dir/nav.txt` and `dir/nav.csv` (the directory is created if needed).
+    /// Create `dir/nav.txt` and `dir/nav.csv` with the ten columns of
+    /// [`CSV_HEADER`] (the directory is created if needed).
     pub fn create(dir: &Path, week: u32) -> Result<Self> {
+        Self::open(dir, week, None)
+    }
+
+    /// Create `dir/nav.txt` and `dir/nav.csv` with the columns of
+    /// [`CSV_HEADER_EXTENDED`]; [`NavWriter::write`] then computes ECEF on `earth`'s
+    /// ellipsoid.
+    pub fn create_extended<E: EarthModel>(dir: &Path, week: u32, earth: &E) -> Result<Self> {
+        let geometry = (earth.semi_major_axis(), earth.eccentricity_squared());
+        Self::open(dir, week, Some(geometry))
+    }
+
+    fn open(dir: &Path, week: u32, extended: Option<(f64, f64)>) -> Result<Self> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
         let open = |name: &str| -> Result<(BufWriter<File>, PathBuf)> {
@@ -121,7 +176,12 @@ impl NavWriter {
         };
         let (txt, txt_path) = open("nav.txt")?;
         let (mut csv, csv_path) = open("nav.csv")?;
-        writeln!(csv, "{CSV_HEADER}")
+        let header = if extended.is_some() {
+            CSV_HEADER_EXTENDED
+        } else {
+            CSV_HEADER
+        };
+        writeln!(csv, "{header}")
             .with_context(|| format!("cannot write {}", csv_path.display()))?;
         Ok(Self {
             txt,
@@ -131,11 +191,30 @@ impl NavWriter {
             week,
             line: Vec::with_capacity(256),
             rows: 0,
+            extended,
         })
     }
 
-    /// Write one epoch to both files.
+    /// Write one NED epoch to both files (in an extended CSV with ECEF from the
+    /// geodetic position and wander azimuth 0).
     pub fn write(&mut self, s: &NavState) -> Result<()> {
+        let (a, e2) = self.extended.unwrap_or((1.0, 0.0));
+        let r_e = if self.extended.is_some() {
+            ecef_of(&s.pos, a, e2)
+        } else {
+            Vector3::zeros()
+        };
+        self.write_epoch(&NavEpoch {
+            state: *s,
+            r_e,
+            wander_azimuth: 0.0,
+        })
+    }
+
+    /// Write one epoch to both files; the ECEF position and wander azimuth go to the
+    /// extended CSV only. Decimals: 1 um for ECEF, 1e-9 deg for the azimuth.
+    pub fn write_epoch(&mut self, epoch: &NavEpoch) -> Result<()> {
+        let s = &epoch.state;
         let row = Row::of(s);
         self.line.clear();
         let mut b = itoa::Buffer::new();
@@ -151,6 +230,17 @@ impl NavWriter {
         self.line.clear();
         push_fixed(&mut self.line, s.t, 6);
         row.push(&mut self.line, b',');
+        if self.extended.is_some() {
+            for (x, d) in [
+                (epoch.r_e.x, 6),
+                (epoch.r_e.y, 6),
+                (epoch.r_e.z, 6),
+                (wrap_lon_deg(epoch.wander_azimuth), 9),
+            ] {
+                self.line.push(b',');
+                push_fixed(&mut self.line, x, d);
+            }
+        }
         self.line.push(b'\n');
         self.csv
             .write_all(&self.line)

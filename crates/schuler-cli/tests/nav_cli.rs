@@ -176,8 +176,10 @@ fn output_rate_and_window() {
     assert_eq!(times.last(), Some(&101.5));
     assert_eq!(times.len(), 11, "{times:?}");
     let csv = std::fs::read_to_string(dir.path().join("out/nav.csv")).expect("nav.csv");
+    // The KF-GINS columns first, then ECEF position and wander azimuth (issue 6).
     assert!(csv.starts_with(
-        "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg\n"
+        "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,\
+         x_ecef_m,y_ecef_m,z_ecef_m,wander_azimuth_deg\n"
     ));
     assert_eq!(csv.lines().count(), 12);
     // Every nav.txt line has the 11 KF-GINS columns.

@@ -2,17 +2,26 @@
 //!
 //! Reads the log lazily, starts from the given initial state at the time tag of the
 //! first processed sample, mechanizes every later sample and writes `nav.txt`
-//! (KF-GINS navigation-result format) and `nav.csv` at the requested output rate.
+//! (KF-GINS navigation-result format) and `nav.csv` (with ECEF position and wander
+//! azimuth) at the requested output rate.
+//!
+//! Mechanizations (`--mechanization`): `ned` (latitude/longitude, singular at the
+//! poles), `wander` (the all-latitude free-azimuth mechanization of seed 003, valid
+//! everywhere), or `auto` (default): NED while `|lat| <= auto_latitude`, wander above
+//! it, back to NED below `auto_latitude − auto_hysteresis` (defaults 75° and 0.5°).
+//! A hand-over converts the state and the two-sample step history exactly (NED →
+//! wander with wander azimuth 0; wander → NED by turning velocity, attitude and the
+//! history through the azimuth), so the run continues as if uninterrupted.
 
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};
-use crate::output::NavWriter;
+use crate::output::{NavEpoch, NavWriter};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
 use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, Mechanization, NavState};
+use schuler::nav::{LocalLevel, Mechanization, NavState, Wander};
 use schuler::rotation::Euler;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -78,6 +87,68 @@ pub enum LayoutChoice {
     Rates,
 }
 
+/// Which strapdown mechanization integrates the log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MechanizationChoice {
+    /// Local-level NED (latitude, longitude): singular at the poles.
+    Ned,
+    /// All-latitude free-azimuth (wander) frame with quaternion position (seed 003).
+    Wander,
+    /// NED up to `--auto-latitude`, wander above it (hand-over both ways with
+    /// hysteresis).
+    #[default]
+    Auto,
+}
+
+/// Which mechanization is running.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MechanizationKind {
+    /// [`LocalLevel`] (NED).
+    Ned,
+    /// [`Wander`].
+    Wander,
+}
+
+impl std::fmt::Display for MechanizationKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Ned => "NED",
+            Self::Wander => "wander",
+        })
+    }
+}
+
+/// The mechanization and, for `auto`, its switching latitudes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MechanizationSettings {
+    /// NED, wander or automatic.
+    pub choice: MechanizationChoice,
+    /// `auto` switches to wander when `|lat|` exceeds this [rad] (default 75°).
+    pub auto_latitude: f64,
+    /// `auto` switches back to NED when `|lat|` falls below
+    /// `auto_latitude − hysteresis` [rad] (default 0.5°).
+    pub hysteresis: f64,
+}
+
+impl MechanizationSettings {
+    /// Default `auto` switching latitude [deg].
+    pub const AUTO_LATITUDE_DEG: f64 = 75.0;
+    /// Default hysteresis of the hand-back [deg]: 55 km of latitude, so a flight
+    /// along the threshold does not hand over at every sample.
+    pub const HYSTERESIS_DEG: f64 = 0.5;
+}
+
+impl Default for MechanizationSettings {
+    fn default() -> Self {
+        Self {
+            choice: MechanizationChoice::Auto,
+            auto_latitude: Self::AUTO_LATITUDE_DEG.to_radians(),
+            hysteresis: Self::HYSTERESIS_DEG.to_radians(),
+        }
+    }
+}
+
 /// Arguments of `schuler nav`; every flag can also come from `--config FILE.toml`
 /// under the same name with underscores (flags win).
 #[derive(clap::Args, Debug, Default)]
@@ -131,6 +202,15 @@ pub struct NavArgs {
     /// free fall, centrifuges and other starts far from 1 g).
     #[arg(long)]
     pub no_layout_check: bool,
+    /// Strapdown mechanization (default auto: NED, wander at high latitude).
+    #[arg(long, value_enum)]
+    pub mechanization: Option<MechanizationChoice>,
+    /// `auto`: latitude [deg] above which the wander mechanization runs (default 75).
+    #[arg(long, value_name = "DEG")]
+    pub auto_latitude: Option<f64>,
+    /// `auto`: NED resumes below `auto_latitude` minus this [deg] (default 0.5).
+    #[arg(long, value_name = "DEG")]
+    pub auto_hysteresis: Option<f64>,
 }
 
 /// The same options as a TOML file.
@@ -151,6 +231,9 @@ struct NavConfig {
     imu_rate: Option<f64>,
     week: Option<u32>,
     no_layout_check: Option<bool>,
+    mechanization: Option<MechanizationChoice>,
+    auto_latitude: Option<f64>,
+    auto_hysteresis: Option<f64>,
 }
 
 /// Everything `nav` needs, validated.
@@ -191,12 +274,51 @@ fn load_config(path: &Path) -> Result<NavConfig> {
 }
 
 impl NavSettings {
-    /// Merge flags over the config file and check every value.
+    /// Merge flags over the config file and check every value (the mechanization
+    /// options are checked and dropped: see [`parse_nav_args`]).
     pub fn from_args(args: NavArgs) -> Result<Self> {
+        parse_nav_args(args).map(|(settings, _)| settings)
+    }
+}
+
+/// The mechanization options of flags over config, checked.
+fn mechanization_settings(args: &NavArgs, cfg: &NavConfig) -> Result<MechanizationSettings> {
+    let choice = args.mechanization.or(cfg.mechanization).unwrap_or_default();
+    let lat = args
+        .auto_latitude
+        .or(cfg.auto_latitude)
+        .unwrap_or(MechanizationSettings::AUTO_LATITUDE_DEG);
+    if !(lat.is_finite() && lat > 0.0 && lat < 90.0) {
+        bail!("--auto-latitude must be between 0 and 90 deg (exclusive), got {lat}");
+    }
+    let hysteresis = args
+        .auto_hysteresis
+        .or(cfg.auto_hysteresis)
+        .unwrap_or(MechanizationSettings::HYSTERESIS_DEG);
+    if !(hysteresis.is_finite() && hysteresis >= 0.0 && hysteresis < lat) {
+        bail!(
+            "--auto-hysteresis must be at least 0 and below --auto-latitude ({lat} deg), \
+             got {hysteresis}"
+        );
+    }
+    Ok(MechanizationSettings {
+        choice,
+        auto_latitude: lat.to_radians(),
+        hysteresis: hysteresis.to_radians(),
+    })
+}
+
+/// Merge flags over the config file and check every value: the run's settings and
+/// its mechanization. (The mechanization is kept apart from [`NavSettings`] so that
+/// code building `NavSettings` field by field keeps compiling; [`navigate`] uses the
+/// default, `auto` at 75°.)
+pub fn parse_nav_args(args: NavArgs) -> Result<(NavSettings, MechanizationSettings)> {
+    {
         let cfg = match &args.config {
             Some(p) => load_config(p)?,
             None => NavConfig::default(),
         };
+        let mechanization = mechanization_settings(&args, &cfg)?;
         let imu = args
             .imu
             .or(cfg.imu)
@@ -249,7 +371,7 @@ impl NavSettings {
             t_end: end,
             check_layout: !(args.no_layout_check || cfg.no_layout_check.unwrap_or(false)),
         };
-        Ok(Self {
+        let settings = NavSettings {
             imu,
             read,
             init_pos: Geodetic::from_degrees(lat, lon, h),
@@ -259,7 +381,8 @@ impl NavSettings {
             out: args.out.or(cfg.out).unwrap_or_else(|| PathBuf::from(".")),
             earth: args.earth.or(cfg.earth).unwrap_or_default(),
             week: args.week.or(cfg.week).unwrap_or(0),
-        })
+        };
+        Ok((settings, mechanization))
     }
 }
 
@@ -278,6 +401,138 @@ pub struct NavSummary {
     pub last: NavState,
     /// Gap warning, if any.
     pub gaps: Option<String>,
+    /// The mechanization at the start.
+    pub first_mechanization: MechanizationKind,
+    /// Hand-overs between mechanizations (`auto`), in order.
+    pub handovers: Vec<Handover>,
+}
+
+/// One hand-over of `auto`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Handover {
+    /// Time [s] of the state handed over.
+    pub t: f64,
+    /// Latitude [rad] there.
+    pub lat: f64,
+    /// The mechanization taking over.
+    pub to: MechanizationKind,
+}
+
+/// The running mechanization.
+#[derive(Debug, Clone)]
+enum Engine<E: EarthModel> {
+    Ned(LocalLevel<E>),
+    Wander(Wander<E>),
+}
+
+/// A mechanization that hands over between NED and wander as `settings` says.
+#[derive(Debug, Clone)]
+struct Navigator<E: EarthModel> {
+    engine: Engine<E>,
+    earth: E,
+    auto: bool,
+    /// `auto`: wander above this `|sin lat|`, NED below `sin_leave`.
+    sin_enter: f64,
+    sin_leave: f64,
+    handovers: Vec<Handover>,
+}
+
+impl<E: EarthModel> Navigator<E> {
+    fn new(earth: E, init: NavState, settings: &MechanizationSettings) -> Self {
+        let sin_enter = settings.auto_latitude.sin();
+        let sin_leave = (settings.auto_latitude - settings.hysteresis).sin();
+        let wander = match settings.choice {
+            MechanizationChoice::Ned => false,
+            MechanizationChoice::Wander => true,
+            MechanizationChoice::Auto => init.pos.lat.sin().abs() > sin_enter,
+        };
+        let engine = if wander {
+            Engine::Wander(Wander::new(earth, init))
+        } else {
+            Engine::Ned(LocalLevel::new(earth, init))
+        };
+        Self {
+            engine,
+            earth,
+            auto: settings.choice == MechanizationChoice::Auto,
+            sin_enter,
+            sin_leave,
+            handovers: Vec::new(),
+        }
+    }
+
+    fn kind(&self) -> MechanizationKind {
+        match self.engine {
+            Engine::Ned(_) => MechanizationKind::Ned,
+            Engine::Wander(_) => MechanizationKind::Wander,
+        }
+    }
+
+    fn prime(&mut self, s: &ImuSample) {
+        match &mut self.engine {
+            Engine::Ned(m) => m.prime(s),
+            Engine::Wander(m) => m.prime(s),
+        }
+    }
+
+    #[inline]
+    fn step(&mut self, s: &ImuSample) {
+        match &mut self.engine {
+            Engine::Ned(m) => {
+                m.step(s);
+                if self.auto && m.state().pos.lat.sin().abs() > self.sin_enter {
+                    let w = Wander::from_local_level(m);
+                    self.record(w.state(), MechanizationKind::Wander);
+                    self.engine = Engine::Wander(w);
+                }
+            }
+            Engine::Wander(m) => {
+                m.step(s);
+                if self.auto && m.sin_lat().abs() < self.sin_leave {
+                    let n = m.to_local_level();
+                    self.record(n.state(), MechanizationKind::Ned);
+                    self.engine = Engine::Ned(n);
+                }
+            }
+        }
+    }
+
+    fn record(&mut self, s: NavState, to: MechanizationKind) {
+        self.handovers.push(Handover {
+            t: s.t,
+            lat: s.pos.lat,
+            to,
+        });
+    }
+
+    fn state(&self) -> NavState {
+        match &self.engine {
+            Engine::Ned(m) => m.state(),
+            Engine::Wander(m) => m.state(),
+        }
+    }
+
+    /// The epoch to write: NED state, ECEF position, wander azimuth (0 in NED).
+    fn epoch(&self) -> NavEpoch {
+        match &self.engine {
+            Engine::Ned(m) => {
+                let state = m.state();
+                NavEpoch {
+                    state,
+                    r_e: self.earth.geodetic_to_ecef(&state.pos),
+                    wander_azimuth: 0.0,
+                }
+            }
+            Engine::Wander(m) => {
+                let (state, wander_azimuth) = m.nav_state_and_azimuth();
+                NavEpoch {
+                    state,
+                    r_e: m.ecef_position(),
+                    wander_azimuth,
+                }
+            }
+        }
+    }
 }
 
 /// Decides which epochs to write: every one, or the first epoch at or after each
@@ -312,11 +567,35 @@ impl Decimator {
 }
 
 /// Run free-inertial navigation over `samples` (the first one carries the initial
-/// state), writing through `writer`. On a read error everything computed so far is
-/// flushed before the error is returned.
+/// state), writing through `writer`, with the default mechanization settings (`auto`
+/// at 75°: NED at lower latitudes, so mid-latitude results are NED's exactly).
 pub fn navigate<E: EarthModel, I>(
     earth: E,
     settings: &NavSettings,
+    samples: I,
+    writer: NavWriter,
+    on_sample: impl FnMut(u64),
+) -> Result<NavSummary>
+where
+    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+{
+    navigate_with(
+        earth,
+        settings,
+        &MechanizationSettings::default(),
+        samples,
+        writer,
+        on_sample,
+    )
+}
+
+/// Run free-inertial navigation over `samples` (the first one carries the initial
+/// state) with the given mechanization, writing through `writer`. On a read error
+/// everything computed so far is flushed before the error is returned.
+pub fn navigate_with<E: EarthModel, I>(
+    earth: E,
+    settings: &NavSettings,
+    mechanization: &MechanizationSettings,
     mut samples: I,
     mut writer: NavWriter,
     mut on_sample: impl FnMut(u64),
@@ -337,11 +616,12 @@ where
         settings.init_vel,
         settings.init_att,
     );
-    let mut nav = LocalLevel::new(earth, init);
+    let mut nav = Navigator::new(earth, init, mechanization);
+    let first_mechanization = nav.kind();
     nav.prime(&first);
     let mut decimator = Decimator::new(settings.output_rate);
     decimator.take(first.t, first.dt);
-    writer.write(&init)?;
+    writer.write_epoch(&nav.epoch())?;
     let mut n = 0u64;
     let mut last_t = first.t;
     let mut last_written = first.t;
@@ -349,14 +629,14 @@ where
         let s = match s {
             Ok(s) => s,
             Err(e) => {
-                let state = nav.state();
-                if last_written != state.t {
-                    writer.write(&state)?;
+                let epoch = nav.epoch();
+                if last_written != epoch.state.t {
+                    writer.write_epoch(&epoch)?;
                 }
                 let rows = writer.finish()?;
                 return Err(anyhow::Error::new(e).context(format!(
                     "stopped after {n} samples; {rows} epochs up to t = {} were written to {}",
-                    state.t,
+                    epoch.state.t,
                     settings.out.display()
                 )));
             }
@@ -365,7 +645,7 @@ where
         n += 1;
         last_t = s.t;
         if decimator.take(s.t, s.dt) {
-            writer.write(&nav.state())?;
+            writer.write_epoch(&nav.epoch())?;
             last_written = s.t;
         }
         if n.is_multiple_of(65_536) {
@@ -380,12 +660,14 @@ where
         t_last: last_t,
         last: nav.state(),
         gaps: None,
+        first_mechanization,
+        handovers: nav.handovers,
     })
 }
 
 /// `schuler nav`.
 pub fn run(args: NavArgs) -> Result<()> {
-    let settings = NavSettings::from_args(args)?;
+    let (settings, mechanization) = parse_nav_args(args)?;
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
@@ -409,24 +691,18 @@ pub fn run(args: NavArgs) -> Result<()> {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let progress = reader.progress();
-    let writer = NavWriter::create(&settings.out, settings.week)?;
     let on_sample = |_| bar.set_position(progress.bytes());
+    let mech = &mechanization;
     let mut summary = match settings.earth {
-        EarthChoice::Wgs84 => navigate(Wgs84, &settings, &mut reader, writer, on_sample),
-        EarthChoice::Sphere => navigate(
-            Sphere::textbook(true),
-            &settings,
-            &mut reader,
-            writer,
-            on_sample,
-        ),
-        EarthChoice::SphereFixed => navigate(
-            Sphere::textbook(false),
-            &settings,
-            &mut reader,
-            writer,
-            on_sample,
-        ),
+        EarthChoice::Wgs84 => {
+            let writer = NavWriter::create_extended(&settings.out, settings.week, &Wgs84)?;
+            navigate_with(Wgs84, &settings, mech, &mut reader, writer, on_sample)
+        }
+        EarthChoice::Sphere | EarthChoice::SphereFixed => {
+            let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
+            let writer = NavWriter::create_extended(&settings.out, settings.week, &sphere)?;
+            navigate_with(sphere, &settings, mech, &mut reader, writer, on_sample)
+        }
     }?;
     bar.set_position(reader.bytes_read());
     bar.finish_and_clear();
@@ -436,7 +712,20 @@ pub fn run(args: NavArgs) -> Result<()> {
         summary.gaps = Some(report.to_string());
     }
     let secs = started.elapsed().as_secs_f64();
-    let e = summary.last.euler();
+    println!(
+        "mechanization: {} from the start",
+        summary.first_mechanization
+    );
+    for h in &summary.handovers {
+        println!(
+            "  hand-over to {} at t = {} s, lat {:.6} deg",
+            h.to,
+            h.t,
+            h.lat.to_degrees()
+        );
+    }
+    let last = summary.last.normalized();
+    let e = last.euler();
     println!(
         "navigated {} samples, t = {} .. {} s ({:.1} s of data) in {:.2} s ({:.2} M samples/s)",
         summary.samples,
@@ -448,12 +737,12 @@ pub fn run(args: NavArgs) -> Result<()> {
     );
     println!(
         "final: lat {:.9} deg, lon {:.9} deg, h {:.3} m, v_ned [{:.3}, {:.3}, {:.3}] m/s, roll {:.4} pitch {:.4} yaw {:.4} deg",
-        summary.last.pos.lat.to_degrees(),
-        summary.last.pos.lon.to_degrees(),
-        summary.last.pos.h,
-        summary.last.v_n.x,
-        summary.last.v_n.y,
-        summary.last.v_n.z,
+        last.pos.lat.to_degrees(),
+        (last.pos.lon.to_degrees() + 180.0).rem_euclid(360.0) - 180.0,
+        last.pos.h,
+        last.v_n.x,
+        last.v_n.y,
+        last.v_n.z,
         e.roll.to_degrees(),
         e.pitch.to_degrees(),
         e.heading_0_2pi().to_degrees()

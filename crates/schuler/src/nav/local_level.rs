@@ -19,13 +19,19 @@
 //! The third-order rotation term `⅙ dθ×(dθ×dv)` is not in KF-GINS: without it a
 //! 30-min maneuvering flight at 200 Hz errs by 2.5 cm, with it by 7 µm (test
 //! `strapdown_exact`), and classical sculling's residual matches the closed form.
-//! Latitude and longitude are singular at the poles: use
-//! the wander-azimuth mechanization there.
+//! The building blocks shared with the wander-azimuth mechanization live in
+//! [`super::strapdown`]. Latitude and longitude are singular at the poles (the
+//! longitude rate `v_E / ((R_N + h) cos lat)` and the transport rate's vertical
+//! component `−v_E tan(lat) / (R_N + h)` grow without bound): use the wander-azimuth
+//! mechanization [`super::wander`] there.
 
+use super::strapdown::{
+    StepHistory, body_rotation_vector, body_velocity_increment, resolve_in_nav_frame,
+    update_attitude,
+};
 use super::{Corrections, Mechanization, NavState};
 use crate::earth::{EarthModel, Geodetic};
 use crate::imu::ImuSample;
-use crate::rotation::quaternion_from_rotation_vector;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// NED strapdown mechanization over an Earth model `E`.
@@ -37,15 +43,11 @@ pub struct LocalLevel<E: EarthModel> {
     pos: Geodetic,
     v_n: Vector3<f64>,
     q_bn: UnitQuaternion<f64>,
-    /// Velocity change over the previous interval, and that interval's length, for
-    /// extrapolating to the middle of the next one.
-    prev_dv_n: Vector3<f64>,
-    prev_dt: f64,
+    /// Previous increments and velocity change (NED), for the two-sample corrections
+    /// and the mid-interval extrapolation.
+    history: StepHistory,
     /// Meridian radius at the last step's middle, to predict the next middle latitude.
     meridian_radius: f64,
-    /// Previous sample's increments for the two-sample corrections; `None` before the
-    /// first step (the corrections are then zero, exact for constant rates).
-    prev: Option<(Vector3<f64>, Vector3<f64>)>,
 }
 
 impl<E: EarthModel> LocalLevel<E> {
@@ -58,10 +60,8 @@ impl<E: EarthModel> LocalLevel<E> {
             pos: initial.pos,
             v_n: initial.v_n,
             q_bn: initial.q_bn,
-            prev_dv_n: Vector3::zeros(),
-            prev_dt: 0.0,
+            history: StepHistory::default(),
             meridian_radius: earth.radii(initial.pos.lat).meridian,
-            prev: None,
         }
     }
 
@@ -71,9 +71,27 @@ impl<E: EarthModel> LocalLevel<E> {
         self
     }
 
+    /// The same mechanization continuing from `history` (previous increments and the
+    /// previous velocity change in NED), e.g. after a hand-over from another
+    /// mechanization.
+    pub fn with_history(mut self, history: StepHistory) -> Self {
+        self.history = history;
+        self
+    }
+
     /// The Earth model in use.
     pub fn earth(&self) -> &E {
         &self.earth
+    }
+
+    /// The second-order corrections in use.
+    pub fn corrections(&self) -> Corrections {
+        self.corrections
+    }
+
+    /// The step history (previous increments, previous velocity change in NED).
+    pub fn history(&self) -> StepHistory {
+        self.history
     }
 }
 
@@ -82,16 +100,11 @@ impl<E: EarthModel> Mechanization for LocalLevel<E> {
     fn step(&mut self, s: &ImuSample) {
         let dt = s.dt;
         let (dth, dv) = (s.dtheta, s.dvel);
-        let (dth_prev, dv_prev) = self.prev.unwrap_or((dth, dv));
+        let prev = self.history.prev_or(&dth, &dv);
 
         // --- 1. velocity, with the middle of the interval extrapolated ---
         let v0 = self.v_n;
-        let ratio = if self.prev_dt > 0.0 {
-            0.5 * dt / self.prev_dt
-        } else {
-            0.0
-        };
-        let v_mid = v0 + self.prev_dv_n * ratio;
+        let v_mid = v0 + self.history.prev_dv * self.history.midpoint_ratio(dt);
         let h_mid = self.pos.h - 0.5 * v_mid.z * dt;
         let lat_mid = self.pos.lat + 0.5 * v_mid.x * dt / (self.meridian_radius + h_mid);
         // One evaluation of the Earth model per step, at the predicted middle. The
@@ -103,13 +116,8 @@ impl<E: EarthModel> Mechanization for LocalLevel<E> {
         let w_en = mid.w_en_n(&v_mid);
         let zeta = (w_ie + w_en) * dt;
 
-        let dth_x_dv = dth.cross(&dv);
-        let mut dv_f_b = dv + 0.5 * dth_x_dv + dth.cross(&dth_x_dv) / 6.0;
-        if self.corrections.sculling {
-            dv_f_b += (dth_prev.cross(&dv) + dv_prev.cross(&dth)) / 12.0;
-        }
-        let dv_f_bn = self.q_bn * dv_f_b;
-        let dv_f_n = dv_f_bn - 0.5 * zeta.cross(&dv_f_bn);
+        let dv_f_b = body_velocity_increment(&dth, &dv, &prev, self.corrections);
+        let dv_f_n = resolve_in_nav_frame(&self.q_bn, &dv_f_b, &zeta);
         let dv_g_n = (mid.g_n - (2.0 * w_ie + w_en).cross(&v_mid)) * dt;
         let v1 = v0 + dv_f_n + dv_g_n;
 
@@ -121,28 +129,20 @@ impl<E: EarthModel> Mechanization for LocalLevel<E> {
         let lon1 = self.pos.lon + v_avg.y * dt / ((mid.radii.prime_vertical + h_avg) * mid.cos_lat);
 
         // --- 3. attitude, with the navigation-frame rotation at the updated middle ---
-        let mut phi = dth;
-        if self.corrections.coning {
-            phi += dth_prev.cross(&dth) / 12.0;
-        }
+        let phi = body_rotation_vector(&dth, &prev.0, self.corrections);
         mid.h = h_avg;
         let w_in = w_ie + mid.w_en_n(&v_avg);
-        let q_nn = quaternion_from_rotation_vector(&(-w_in * dt));
-        let q_bb = quaternion_from_rotation_vector(&phi);
-        let q = (q_nn * self.q_bn * q_bb).into_inner();
-        self.q_bn = UnitQuaternion::new_normalize(q);
+        self.q_bn = update_attitude(&self.q_bn, &(w_in * dt), &phi);
 
         self.meridian_radius = mid.radii.meridian;
-        self.prev_dv_n = v1 - v0;
-        self.prev_dt = dt;
-        self.prev = Some((dth, dv));
+        self.history.record(dth, dv, v1 - v0, dt);
         self.v_n = v1;
         self.pos = Geodetic::new(lat1, lon1, h1);
         self.t = s.t;
     }
 
     fn prime(&mut self, previous: &ImuSample) {
-        self.prev = Some((previous.dtheta, previous.dvel));
+        self.history.prev_increments = Some((previous.dtheta, previous.dvel));
     }
 
     fn state(&self) -> NavState {

@@ -2,13 +2,25 @@
 //! attitude, one sample per call, with no heap allocation.
 //!
 //! Every mechanization implements [`Mechanization`], so the CLI, the filter and the
-//! alignment are written once for all of them.
+//! alignment are written once for all of them:
+//!
+//! - [`LocalLevel`]: NED, latitude and longitude as position (singular at the poles);
+//! - [`Wander`]: all-latitude free-azimuth frame with quaternion position (seed 003),
+//!   valid everywhere including exactly at a pole.
+//!
+//! Both share the increment algorithm of [`strapdown`], and either hands its state
+//! and step history to the other without loss ([`Wander::from_local_level`],
+//! [`Wander::to_local_level`]).
 
 pub mod local_level;
 pub mod state;
+pub mod strapdown;
+pub mod wander;
 
 pub use local_level::LocalLevel;
 pub use state::NavState;
+pub use strapdown::StepHistory;
+pub use wander::{Wander, WanderState};
 
 use crate::imu::ImuSample;
 
