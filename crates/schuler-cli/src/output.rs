@@ -57,6 +57,26 @@ fn wrap_lon_deg(lon_rad: f64) -> f64 {
     if w == -180.0 { 180.0 } else { w }
 }
 
+/// Longitude-like angle `x` [deg] in (−180, 180] that stays there when printed
+/// with `decimals` digits: −180 + 1e-13 would print as −180.000…, so it becomes 180.
+fn printable_lon(x: f64, decimals: i32) -> f64 {
+    if x < -180.0 + 0.5 * 10f64.powi(-decimals) {
+        180.0
+    } else {
+        x
+    }
+}
+
+/// Heading `y` [deg] in [0, 360) that stays there when printed with `decimals`
+/// digits: 360 − 1e-13 would print as 360.000…, so it becomes 0.
+fn printable_heading(y: f64, decimals: i32) -> f64 {
+    if y >= 360.0 - 0.5 * 10f64.powi(-decimals) {
+        0.0
+    } else {
+        y
+    }
+}
+
 /// One navigation epoch in output units.
 struct Row {
     lat_deg: f64,
@@ -74,12 +94,12 @@ impl Row {
         let e = s.euler();
         Self {
             lat_deg: s.pos.lat.to_degrees(),
-            lon_deg: wrap_lon_deg(s.pos.lon),
+            lon_deg: printable_lon(wrap_lon_deg(s.pos.lon), 11),
             h: s.pos.h,
             v: [s.v_n.x, s.v_n.y, s.v_n.z],
             roll_deg: e.roll.to_degrees(),
             pitch_deg: e.pitch.to_degrees(),
-            yaw_deg: e.heading_0_2pi().to_degrees(),
+            yaw_deg: printable_heading(e.heading_0_2pi().to_degrees(), 9),
         }
     }
 
@@ -235,7 +255,7 @@ impl NavWriter {
                 (epoch.r_e.x, 6),
                 (epoch.r_e.y, 6),
                 (epoch.r_e.z, 6),
-                (wrap_lon_deg(epoch.wander_azimuth), 9),
+                (printable_lon(wrap_lon_deg(epoch.wander_azimuth), 9), 9),
             ] {
                 self.line.push(b',');
                 push_fixed(&mut self.line, x, d);
@@ -331,6 +351,71 @@ mod tests {
         assert!((wrap_lon_deg(-190f64.to_radians()) - 170.0).abs() < 1e-12);
         assert_eq!(wrap_lon_deg(180f64.to_radians()), 180.0);
         assert_eq!(wrap_lon_deg(-180f64.to_radians()), 180.0);
+    }
+
+    /// Angles a hair inside the range print inside it: yaw just below 360 deg as 0,
+    /// longitude just above -180 deg as 180 (seen on a polar flight: yaw
+    /// 360 - 1e-13 deg printed as 360.000000000).
+    #[test]
+    fn printed_angles_stay_half_open() {
+        let mut s = NavState::new(
+            1.0,
+            Geodetic::new(0.3, (-180.0f64 + 1e-13).to_radians(), 10.0),
+            Vector3::zeros(),
+            schuler::rotation::Euler::new(0.0, 0.0, -1e-15),
+        );
+        let row = Row::of(&s);
+        assert_eq!(row.yaw_deg, 0.0);
+        assert_eq!(row.lon_deg, 180.0);
+        s.q_bn = schuler::rotation::Euler::from_degrees(0.0, 0.0, 359.9).to_quaternion();
+        let row = Row::of(&s);
+        assert!((row.yaw_deg - 359.9).abs() < 1e-9);
+        let mut line = Vec::new();
+        row.push(&mut line, b' ');
+        let text = String::from_utf8(line).expect("ascii");
+        let fields: Vec<&str> = text.split_whitespace().collect();
+        assert_eq!(fields[1], "180.00000000000");
+        assert_eq!(fields[8], "359.900000000");
+    }
+
+    /// The extended CSV: header, 14 columns, ECEF from the geodetic position for a
+    /// NED state, azimuth 0; the classic writer keeps its 10 columns.
+    #[test]
+    fn extended_and_classic_csv() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let s = NavState::new(
+            2.0,
+            Geodetic::from_degrees(45.0, 7.0, 100.0),
+            Vector3::new(1.0, 2.0, 3.0),
+            schuler::rotation::Euler::from_degrees(1.0, 2.0, 3.0),
+        );
+        let mut w =
+            NavWriter::create_extended(dir.path(), 7, &schuler::earth::Wgs84).expect("writer");
+        w.write(&s).expect("write");
+        assert_eq!(w.finish().expect("finish"), 1);
+        let csv = std::fs::read_to_string(dir.path().join("nav.csv")).expect("csv");
+        let mut lines = csv.lines();
+        assert_eq!(lines.next(), Some(CSV_HEADER_EXTENDED));
+        let f: Vec<f64> = lines
+            .next()
+            .expect("row")
+            .split(',')
+            .map(|x| x.parse().expect("number"))
+            .collect();
+        assert_eq!(f.len(), 14);
+        let r = schuler::earth::Wgs84.geodetic_to_ecef(&s.pos);
+        for (got, want) in f[10..13].iter().zip(r.iter()) {
+            assert!((got - want).abs() <= 5e-7, "{got} {want}");
+        }
+        assert_eq!(f[13], 0.0);
+
+        let classic = dir.path().join("classic");
+        let mut w = NavWriter::create(&classic, 7).expect("writer");
+        w.write(&s).expect("write");
+        w.finish().expect("finish");
+        let csv = std::fs::read_to_string(classic.join("nav.csv")).expect("csv");
+        assert!(csv.starts_with(&format!("{CSV_HEADER}\n")));
+        assert!(csv.lines().all(|l| l.split(',').count() == 10));
     }
 
     proptest! {

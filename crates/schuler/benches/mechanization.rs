@@ -2,7 +2,9 @@
 //! Throughput of one strapdown mechanization step (issue 2: >= 5 million samples/s on
 //! one core; issue 6: the wander mechanization within 20 % of NED). Samples are
 //! precomputed exact increments of a maneuvering flight at 200 Hz, so the timing is
-//! the mechanization alone; NED and wander step the same samples.
+//! the mechanization alone; NED and wander step the same samples. Measured (idle
+//! 2-core VM): NED 2.81 ms, wander 3.05 ms per 20,000 steps on WGS84 (1.09x);
+//! 3.01 / 3.33 ms on the sphere (1.10x).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use schuler::earth::{Geodetic, Sphere, Wgs84};

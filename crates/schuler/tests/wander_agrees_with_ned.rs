@@ -5,7 +5,7 @@
 
 use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
 use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, Mechanization, NavState, Wander};
+use schuler::nav::{LocalLevel, Mechanization, NavState, Wander, WanderEarth};
 use schuler::sim::analytic::{self, Maneuvering, Trajectory};
 
 const DT: f64 = 1.0 / 200.0;
@@ -18,7 +18,7 @@ fn ecef<E: EarthModel>(earth: &E, s: &NavState) -> nalgebra::Vector3<f64> {
 
 /// The largest ECEF distance between the NED and wander solutions, and the largest
 /// error of each against the truth, over 30 min of the maneuvering flight.
-fn compare<E: EarthModel, T: Trajectory>(earth: E, traj: &T) -> (f64, f64, f64, f64) {
+fn compare<E: WanderEarth, T: Trajectory>(earth: E, traj: &T) -> (f64, f64, f64, f64) {
     let start = analytic::state(&earth, traj, 0.0);
     let before = analytic::increment(&earth, traj, 0.0, DT);
     let mut ned = LocalLevel::new(earth, start);
@@ -51,7 +51,7 @@ fn compare<E: EarthModel, T: Trajectory>(earth: E, traj: &T) -> (f64, f64, f64, 
 /// alike. Attitude: within 1e-5 arcsec, 100x the measured 7e-8 arcsec.
 #[test]
 fn mid_latitude_ned_and_wander_agree_within_one_millimetre() {
-    fn check<E: EarthModel>(name: &str, earth: E) {
+    fn check<E: WanderEarth>(name: &str, earth: E) {
         let traj = Maneuvering::flight(Geodetic::from_degrees(30.5, 114.3, 500.0));
         let (apart, ned_err, wander_err, att) = compare(earth, &traj);
         eprintln!(

@@ -6,7 +6,7 @@
 use nalgebra::{Matrix3, Vector3};
 use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84, c_ne};
 use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, Mechanization, NavState, Wander};
+use schuler::nav::{LocalLevel, Mechanization, NavState, Wander, WanderEarth};
 use schuler::rotation::Euler;
 use schuler::sim::analytic::{self, Stationary, Trajectory};
 use schuler::sim::jet::{Jet, JetMat3, JetVec3};
@@ -177,7 +177,7 @@ fn start<E: EarthModel, T: Trajectory, M: Mechanization>(
 
 /// Runs the wander mechanization over `samples` from the truth, checking ECEF
 /// position, velocity and attitude against the truth every `every` samples.
-fn run_wander<E: EarthModel, T: Trajectory>(
+fn run_wander<E: WanderEarth, T: Trajectory>(
     earth: E,
     traj: &T,
     samples: &[ImuSample],
@@ -239,7 +239,7 @@ const ARCSEC: f64 = std::f64::consts::PI / (180.0 * 3600.0);
 /// the same data: 0.38 m).
 #[test]
 fn polar_flight_wander_within_one_metre() {
-    fn check<E: EarthModel>(name: &str, earth: E) {
+    fn check<E: WanderEarth>(name: &str, earth: E) {
         let traj = OverThePole::flight(&earth, 0.0);
         let data = samples(&earth, &traj, 0.0, DT, N_20_MIN);
         let w = run_wander(earth, &traj, &data, 200);

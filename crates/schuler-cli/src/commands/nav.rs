@@ -21,7 +21,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
 use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, Mechanization, NavState, Wander};
+use schuler::nav::{LocalLevel, Mechanization, NavState, Wander, WanderEarth};
 use schuler::rotation::Euler;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -310,8 +310,8 @@ fn mechanization_settings(args: &NavArgs, cfg: &NavConfig) -> Result<Mechanizati
 
 /// Merge flags over the config file and check every value: the run's settings and
 /// its mechanization. (The mechanization is kept apart from [`NavSettings`] so that
-/// code building `NavSettings` field by field keeps compiling; [`navigate`] uses the
-/// default, `auto` at 75°.)
+/// code building `NavSettings` field by field keeps compiling; it goes to
+/// [`navigate_with`].)
 pub fn parse_nav_args(args: NavArgs) -> Result<(NavSettings, MechanizationSettings)> {
     {
         let cfg = match &args.config {
@@ -418,16 +418,56 @@ pub struct Handover {
     pub to: MechanizationKind,
 }
 
+/// What the sample loop needs from a mechanization (NED only, or hand-over).
+trait Runner {
+    fn kind(&self) -> MechanizationKind;
+    fn prime(&mut self, s: &ImuSample);
+    fn step(&mut self, s: &ImuSample);
+    fn state(&self) -> NavState;
+    fn epoch(&self) -> NavEpoch;
+    fn handovers(self) -> Vec<Handover>;
+}
+
+/// The NED mechanization alone, for any Earth model.
+struct NedOnly<E: EarthModel>(LocalLevel<E>);
+
+impl<E: EarthModel> Runner for NedOnly<E> {
+    fn kind(&self) -> MechanizationKind {
+        MechanizationKind::Ned
+    }
+    fn prime(&mut self, s: &ImuSample) {
+        self.0.prime(s);
+    }
+    #[inline]
+    fn step(&mut self, s: &ImuSample) {
+        self.0.step(s);
+    }
+    fn state(&self) -> NavState {
+        self.0.state()
+    }
+    fn epoch(&self) -> NavEpoch {
+        let state = self.0.state();
+        NavEpoch {
+            state,
+            r_e: self.0.earth().geodetic_to_ecef(&state.pos),
+            wander_azimuth: 0.0,
+        }
+    }
+    fn handovers(self) -> Vec<Handover> {
+        Vec::new()
+    }
+}
+
 /// The running mechanization.
 #[derive(Debug, Clone)]
-enum Engine<E: EarthModel> {
+enum Engine<E: WanderEarth> {
     Ned(LocalLevel<E>),
     Wander(Wander<E>),
 }
 
 /// A mechanization that hands over between NED and wander as `settings` says.
 #[derive(Debug, Clone)]
-struct Navigator<E: EarthModel> {
+struct Navigator<E: WanderEarth> {
     engine: Engine<E>,
     earth: E,
     auto: bool,
@@ -437,7 +477,7 @@ struct Navigator<E: EarthModel> {
     handovers: Vec<Handover>,
 }
 
-impl<E: EarthModel> Navigator<E> {
+impl<E: WanderEarth> Navigator<E> {
     fn new(earth: E, init: NavState, settings: &MechanizationSettings) -> Self {
         let sin_enter = settings.auto_latitude.sin();
         let sin_leave = (settings.auto_latitude - settings.hysteresis).sin();
@@ -461,11 +501,25 @@ impl<E: EarthModel> Navigator<E> {
         }
     }
 
+    fn record(&mut self, s: NavState, to: MechanizationKind) {
+        self.handovers.push(Handover {
+            t: s.t,
+            lat: s.pos.lat,
+            to,
+        });
+    }
+}
+
+impl<E: WanderEarth> Runner for Navigator<E> {
     fn kind(&self) -> MechanizationKind {
         match self.engine {
             Engine::Ned(_) => MechanizationKind::Ned,
             Engine::Wander(_) => MechanizationKind::Wander,
         }
+    }
+
+    fn handovers(self) -> Vec<Handover> {
+        self.handovers
     }
 
     fn prime(&mut self, s: &ImuSample) {
@@ -495,14 +549,6 @@ impl<E: EarthModel> Navigator<E> {
                 }
             }
         }
-    }
-
-    fn record(&mut self, s: NavState, to: MechanizationKind) {
-        self.handovers.push(Handover {
-            t: s.t,
-            lat: s.pos.lat,
-            to,
-        });
     }
 
     fn state(&self) -> NavState {
@@ -567,8 +613,9 @@ impl Decimator {
 }
 
 /// Run free-inertial navigation over `samples` (the first one carries the initial
-/// state), writing through `writer`, with the default mechanization settings (`auto`
-/// at 75°: NED at lower latitudes, so mid-latitude results are NED's exactly).
+/// state) with the NED mechanization, writing through `writer`, for any Earth model.
+/// On a read error everything computed so far is flushed before the error is
+/// returned. (For the wander and automatic mechanizations see [`navigate_with`].)
 pub fn navigate<E: EarthModel, I>(
     earth: E,
     settings: &NavSettings,
@@ -579,23 +626,43 @@ pub fn navigate<E: EarthModel, I>(
 where
     I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
 {
-    navigate_with(
-        earth,
+    run_samples(
+        |init| NedOnly(LocalLevel::new(earth, init)),
         settings,
-        &MechanizationSettings::default(),
         samples,
         writer,
         on_sample,
     )
 }
 
-/// Run free-inertial navigation over `samples` (the first one carries the initial
-/// state) with the given mechanization, writing through `writer`. On a read error
-/// everything computed so far is flushed before the error is returned.
-pub fn navigate_with<E: EarthModel, I>(
+/// As [`navigate`], with the mechanization `mechanization` (NED, wander, or
+/// automatic hand-over), on an Earth model the wander mechanization can evaluate
+/// ([`WanderEarth`]: WGS84 and the sphere).
+pub fn navigate_with<E: WanderEarth, I>(
     earth: E,
     settings: &NavSettings,
     mechanization: &MechanizationSettings,
+    samples: I,
+    writer: NavWriter,
+    on_sample: impl FnMut(u64),
+) -> Result<NavSummary>
+where
+    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+{
+    run_samples(
+        |init| Navigator::new(earth, init, mechanization),
+        settings,
+        samples,
+        writer,
+        on_sample,
+    )
+}
+
+/// The sample loop: start `make(initial state)` at the first sample, prime it with
+/// that sample, step every later one, write decimated epochs.
+fn run_samples<R: Runner, I>(
+    make: impl FnOnce(NavState) -> R,
+    settings: &NavSettings,
     mut samples: I,
     mut writer: NavWriter,
     mut on_sample: impl FnMut(u64),
@@ -616,7 +683,7 @@ where
         settings.init_vel,
         settings.init_att,
     );
-    let mut nav = Navigator::new(earth, init, mechanization);
+    let mut nav = make(init);
     let first_mechanization = nav.kind();
     nav.prime(&first);
     let mut decimator = Decimator::new(settings.output_rate);
@@ -661,7 +728,7 @@ where
         last: nav.state(),
         gaps: None,
         first_mechanization,
-        handovers: nav.handovers,
+        handovers: nav.handovers(),
     })
 }
 

@@ -20,7 +20,7 @@ pub mod wander;
 pub use local_level::LocalLevel;
 pub use state::NavState;
 pub use strapdown::StepHistory;
-pub use wander::{Wander, WanderState};
+pub use wander::{Wander, WanderEarth, WanderState};
 
 use crate::imu::ImuSample;
 
