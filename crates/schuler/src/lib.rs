@@ -5,9 +5,11 @@
 //! (NED); DCMs are named `c_xy` for the transformation from frame `x` to frame `y`
 //! (`v_n = c_bn * v_b`).
 
+pub mod align;
 pub mod analysis;
 pub mod channel;
 pub mod earth;
+pub mod filter;
 pub mod imu;
 pub mod nav;
 pub mod rotation;

@@ -12,11 +12,13 @@
 //! and step history to the other without loss ([`Wander::from_local_level`],
 //! [`Wander::to_local_level`]).
 
+pub mod frame;
 pub mod local_level;
 pub mod state;
 pub mod strapdown;
 pub mod wander;
 
+pub use frame::{ErrorFrame, FrameSnapshot, NavErrors};
 pub use local_level::LocalLevel;
 pub use state::NavState;
 pub use strapdown::StepHistory;

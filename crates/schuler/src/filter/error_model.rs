@@ -1,0 +1,175 @@
+//! Psi-angle error dynamics of a local-level strapdown mechanization (errors in the
+//! computation frame `c`, see [`crate::nav::frame`]), `ẋ = F x + w`:
+//!
+//! - `δṙ = −ρ×δr + δv`
+//! - `δv̇ = G δr − (2ω_ie + ρ)×δv + f^c×ψ + Ĉ_cb (δb_a + diag(f^b) δs_a)`,
+//!   `G = (g/r) diag(−1, −1, 2)` (gravity gradient, down positive)
+//! - `ψ̇ = −(ω_ie + ρ)×ψ − Ĉ_cb (δb_g + diag(ω^b) δs_g)`
+//! - residual biases: random walks ([`super::noise`]); scale factors, the baro bias and
+//!   the reference attitude: constants (the baro bias with an optional walk).
+//!
+//! `ρ` is the transport rate of `c` (with zero vertical component in the wander frame),
+//! so nothing here is singular at a pole (Savage 2000, §12.2; Titterton & Weston 2004,
+//! §12.3.2 for the NED special case).
+//!
+//! Discretization over an interval `T` with the means of the interval: `Φ = I + A +
+//! A²/2 + A³/6` with `A = F T` (the cubic term carries the gyro bias into position),
+//! and `Q_d = Q T + (F Q + Q Fᵀ) T²/2 + F Q Fᵀ T³/3`.
+
+use super::layout::Layout;
+use super::noise::ImuNoise;
+use crate::nav::FrameSnapshot;
+use crate::rotation::skew;
+use nalgebra::{DMatrix, Matrix3, Vector3};
+
+/// The mean kinematics over one propagation interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntervalMeans {
+    /// Interval length [s].
+    pub dt: f64,
+    /// The computation frame (at the interval's end).
+    pub frame: FrameSnapshot,
+    /// Mean specific force in `c` [m/s^2].
+    pub f_c: Vector3<f64>,
+    /// Mean specific force in body axes [m/s^2].
+    pub f_b: Vector3<f64>,
+    /// Mean angular rate in body axes [rad/s].
+    pub w_b: Vector3<f64>,
+}
+
+/// The process model: state layout and noise.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorModel {
+    /// State layout.
+    pub layout: Layout,
+    /// IMU noise.
+    pub noise: ImuNoise,
+    /// Barometer bias random-walk density [m/sqrt(s)].
+    pub baro_bias_walk: f64,
+}
+
+fn put(m: &mut DMatrix<f64>, r: usize, c: usize, b: &Matrix3<f64>) {
+    m.fixed_view_mut::<3, 3>(r, c).copy_from(b);
+}
+
+impl ErrorModel {
+    /// The continuous-time dynamics matrix `F` for the interval's means.
+    pub fn dynamics(&self, m: &IntervalMeans) -> DMatrix<f64> {
+        let (l, f) = (&self.layout, &m.frame);
+        let n = l.n;
+        let mut a = DMatrix::zeros(n, n);
+        let c_bc = f.q_bc.to_rotation_matrix().into_inner();
+        let (p, v, att) = (Layout::POS, Layout::VEL, Layout::ATT);
+        put(&mut a, p, p, &(-skew(&f.rho_c)));
+        put(&mut a, p, v, &Matrix3::identity());
+        let gr = f.gravity / f.radius;
+        put(
+            &mut a,
+            v,
+            p,
+            &Matrix3::from_diagonal(&Vector3::new(-gr, -gr, 2.0 * gr)),
+        );
+        put(&mut a, v, v, &(-skew(&(2.0 * f.w_ie_c + f.rho_c))));
+        put(&mut a, v, att, &skew(&m.f_c));
+        put(&mut a, v, Layout::ACCEL_BIAS, &c_bc);
+        put(&mut a, att, att, &(-skew(&(f.w_ie_c + f.rho_c))));
+        put(&mut a, att, Layout::GYRO_BIAS, &(-c_bc));
+        if let Some(sg) = l.gyro_scale {
+            put(&mut a, att, sg, &(-c_bc * Matrix3::from_diagonal(&m.w_b)));
+        }
+        if let Some(sa) = l.accel_scale {
+            put(&mut a, v, sa, &(c_bc * Matrix3::from_diagonal(&m.f_b)));
+        }
+        a
+    }
+
+    /// The continuous-time process noise density `Q`.
+    pub fn process_noise(&self, m: &IntervalMeans) -> DMatrix<f64> {
+        let (l, nz) = (&self.layout, &self.noise);
+        let mut q = DMatrix::zeros(l.n, l.n);
+        let c_bc = m.frame.q_bc.to_rotation_matrix().into_inner();
+        let sq = |v: &Vector3<f64>| Matrix3::from_diagonal(&v.component_mul(v));
+        put(
+            &mut q,
+            Layout::VEL,
+            Layout::VEL,
+            &(c_bc * sq(&nz.vrw) * c_bc.transpose()),
+        );
+        put(
+            &mut q,
+            Layout::ATT,
+            Layout::ATT,
+            &(c_bc * sq(&nz.arw) * c_bc.transpose()),
+        );
+        put(
+            &mut q,
+            Layout::GYRO_BIAS,
+            Layout::GYRO_BIAS,
+            &sq(&nz.gyro_bias_walk),
+        );
+        put(
+            &mut q,
+            Layout::ACCEL_BIAS,
+            Layout::ACCEL_BIAS,
+            &sq(&nz.accel_bias_walk),
+        );
+        if let Some(b) = l.baro_bias {
+            q[(b, b)] = self.baro_bias_walk * self.baro_bias_walk;
+        }
+        q
+    }
+
+    /// Transition matrix and discrete process noise over the interval.
+    pub fn transition(&self, m: &IntervalMeans) -> (DMatrix<f64>, DMatrix<f64>) {
+        let f = self.dynamics(m);
+        let q = self.process_noise(m);
+        let t = m.dt;
+        let a = &f * t;
+        let a2 = &a * &a;
+        let a3 = &a2 * &a;
+        let phi = DMatrix::identity(self.layout.n, self.layout.n) + &a + &a2 * 0.5 + &a3 / 6.0;
+        let fq = &f * &q;
+        let qd = &q * t
+            + (&fq + fq.transpose()) * (0.5 * t * t)
+            + &fq * f.transpose() * (t * t * t / 3.0);
+        (phi, qd)
+    }
+
+    /// Prior covariance: position, velocity and attitude standard deviations (per axis
+    /// in `c`), and the sensor errors from the noise model.
+    pub fn initial_covariance(
+        &self,
+        pos_std: Vector3<f64>,
+        vel_std: Vector3<f64>,
+        att_std: Vector3<f64>,
+        baro_bias_std: f64,
+    ) -> DMatrix<f64> {
+        let (l, nz) = (&self.layout, &self.noise);
+        let mut d = vec![0.0; l.n];
+        let mut set = |off: usize, v: &Vector3<f64>| {
+            for i in 0..3 {
+                d[off + i] = v[i] * v[i];
+            }
+        };
+        set(Layout::POS, &pos_std);
+        set(Layout::VEL, &vel_std);
+        set(Layout::ATT, &att_std);
+        set(Layout::GYRO_BIAS, &nz.gyro_bias);
+        set(Layout::ACCEL_BIAS, &nz.accel_bias);
+        if let Some(sg) = l.gyro_scale {
+            set(sg, &nz.gyro_scale);
+        }
+        if let Some(sa) = l.accel_scale {
+            set(sa, &nz.accel_scale);
+        }
+        if let Some(b) = l.baro_bias {
+            d[b] = baro_bias_std * baro_bias_std;
+        }
+        let mut p = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(d));
+        if let Some(r) = l.attitude_ref {
+            // The reference attitude error is the attitude error at the start.
+            super::kalman::duplicate_states(&mut p, Layout::ATT, r, 3);
+        }
+        p
+    }
+}

@@ -1,0 +1,19 @@
+//! Error-state (indirect) Kalman filter for strapdown navigation, with closed-loop
+//! feedback into the mechanization.
+//!
+//! - [`layout`]: which errors are states and where they sit in the vector;
+//! - [`noise`]: the IMU noise model the process noise comes from;
+//! - [`error_model`]: the psi-angle error dynamics `F`, their transition matrix and
+//!   discrete process noise (non-singular at the poles, see [`crate::nav::frame`]);
+//! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
+//!   innovation gate.
+
+pub mod error_model;
+pub mod kalman;
+pub mod layout;
+pub mod noise;
+
+pub use error_model::{ErrorModel, IntervalMeans};
+pub use kalman::{Gate, Kalman, Rejection, Update};
+pub use layout::Layout;
+pub use noise::ImuNoise;
