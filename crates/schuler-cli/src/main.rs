@@ -17,6 +17,8 @@ struct Cli {
 enum Command {
     /// Free-inertial navigation of an IMU log (KF-GINS text or CSV).
     Nav(schuler_cli::commands::nav::NavArgs),
+    /// Initial alignment at rest: gyrocompassing, then the Kalman filter on invariants.
+    Align(schuler_cli::commands::align::Args),
     /// A first end-to-end run on built-in simulated data.
     Demo(schuler_cli::commands::demo::DemoArgs),
     /// Simulate a trajectory and its IMU, GNSS and barometer data.
@@ -31,6 +33,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Nav(args) => schuler_cli::commands::nav::run(args),
+        Command::Align(args) => schuler_cli::commands::align::run(args),
         Command::Demo(args) => schuler_cli::commands::demo::run(args),
         Command::Simulate(args) => schuler_cli::commands::simulate::run(args),
         Command::Channel(args) => schuler_cli::commands::channel::run(args),

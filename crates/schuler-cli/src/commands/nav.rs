@@ -13,6 +13,7 @@
 //! wander with wander azimuth 0; wander → NED by turning velocity, attitude and the
 //! history through the azimuth), so the run continues as if uninterrupted.
 
+use super::align::AlignOptions;
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};
 use crate::output::{NavEpoch, NavWriter};
 use anyhow::{Context, Result, bail};
@@ -77,6 +78,17 @@ pub enum FormatChoice {
     Csv,
 }
 
+impl FormatChoice {
+    /// The reader's format.
+    pub fn format(self) -> ImuFormat {
+        match self {
+            FormatChoice::Auto => ImuFormat::Auto,
+            FormatChoice::KfGins => ImuFormat::KfGinsText,
+            FormatChoice::Csv => ImuFormat::Csv,
+        }
+    }
+}
+
 /// Whether the sensor columns are increments or rates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -85,6 +97,16 @@ pub enum LayoutChoice {
     Increments,
     /// Mean rates over (t_prev, t] [rad/s, m/s^2].
     Rates,
+}
+
+impl LayoutChoice {
+    /// The reader's layout.
+    pub fn layout(self) -> ImuLayout {
+        match self {
+            LayoutChoice::Increments => ImuLayout::Increments,
+            LayoutChoice::Rates => ImuLayout::Rates,
+        }
+    }
 }
 
 /// Which strapdown mechanization integrates the log.
@@ -211,6 +233,14 @@ pub struct NavArgs {
     /// `auto`: NED resumes below `auto_latitude` minus this [deg] (default 0.5).
     #[arg(long, value_name = "DEG")]
     pub auto_hysteresis: Option<f64>,
+    /// Align first on the log's first `coarse + fine` seconds (the vehicle at rest at
+    /// --init-pos), then navigate from the aligned state with the estimated biases
+    /// removed; --init-att is then not needed. Writes align.json beside nav.txt.
+    #[arg(long)]
+    pub align: bool,
+    /// Alignment options (with --align).
+    #[command(flatten)]
+    pub alignment: AlignOptions,
 }
 
 /// The same options as a TOML file.
@@ -234,6 +264,8 @@ struct NavConfig {
     mechanization: Option<MechanizationChoice>,
     auto_latitude: Option<f64>,
     auto_hysteresis: Option<f64>,
+    align: Option<bool>,
+    alignment: Option<AlignOptions>,
 }
 
 /// Everything `nav` needs, validated.
@@ -277,7 +309,7 @@ impl NavSettings {
     /// Merge flags over the config file and check every value (the mechanization
     /// options are checked and dropped: see [`parse_nav_args`]).
     pub fn from_args(args: NavArgs) -> Result<Self> {
-        parse_nav_args(args).map(|(settings, _)| settings)
+        parse_nav_args(args).map(|(settings, _, _)| settings)
     }
 }
 
@@ -312,7 +344,9 @@ fn mechanization_settings(args: &NavArgs, cfg: &NavConfig) -> Result<Mechanizati
 /// its mechanization. (The mechanization is kept apart from [`NavSettings`] so that
 /// code building `NavSettings` field by field keeps compiling; it goes to
 /// [`navigate_with`].)
-pub fn parse_nav_args(args: NavArgs) -> Result<(NavSettings, MechanizationSettings)> {
+pub fn parse_nav_args(
+    args: NavArgs,
+) -> Result<(NavSettings, MechanizationSettings, Option<AlignOptions>)> {
     {
         let cfg = match &args.config {
             Some(p) => load_config(p)?,
@@ -331,10 +365,20 @@ pub fn parse_nav_args(args: NavArgs) -> Result<(NavSettings, MechanizationSettin
             bail!("--init-pos: latitude {lat} deg is outside [-90, 90]");
         }
         let Triple(v) = args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3]));
-        let Triple([roll, pitch, yaw]) = args.init_att.or(cfg.init_att).context(
-            "no initial attitude: give --init-att ROLL,PITCH,YAW (deg); free-inertial \
-             navigation cannot start without one",
-        )?;
+        let align = (args.align || cfg.align.unwrap_or(false)).then(|| {
+            args.alignment
+                .clone()
+                .or(cfg.alignment.clone().unwrap_or_default())
+        });
+        let init_att = match (args.init_att.or(cfg.init_att), &align) {
+            (Some(a), _) => a,
+            (None, Some(_)) => Triple([0.0; 3]),
+            (None, None) => bail!(
+                "no initial attitude: give --init-att ROLL,PITCH,YAW (deg), or --align to \
+                 align at rest first; free-inertial navigation cannot start without one"
+            ),
+        };
+        let Triple([roll, pitch, yaw]) = init_att;
         if !(-90.0..=90.0).contains(&pitch) {
             bail!("--init-att: pitch {pitch} deg is outside [-90, 90]");
         }
@@ -357,15 +401,12 @@ pub fn parse_nav_args(args: NavArgs) -> Result<(NavSettings, MechanizationSettin
             bail!("--start {s} is not before --end {e}");
         }
         let read = ImuReadOptions {
-            format: match args.imu_format.or(cfg.imu_format).unwrap_or_default() {
-                FormatChoice::Auto => ImuFormat::Auto,
-                FormatChoice::KfGins => ImuFormat::KfGinsText,
-                FormatChoice::Csv => ImuFormat::Csv,
-            },
-            layout: args.imu_layout.or(cfg.imu_layout).map(|l| match l {
-                LayoutChoice::Increments => ImuLayout::Increments,
-                LayoutChoice::Rates => ImuLayout::Rates,
-            }),
+            format: args
+                .imu_format
+                .or(cfg.imu_format)
+                .unwrap_or_default()
+                .format(),
+            layout: args.imu_layout.or(cfg.imu_layout).map(LayoutChoice::layout),
             nominal_dt: imu_rate.map(|r| 1.0 / r),
             t_start: start,
             t_end: end,
@@ -382,7 +423,7 @@ pub fn parse_nav_args(args: NavArgs) -> Result<(NavSettings, MechanizationSettin
             earth: args.earth.or(cfg.earth).unwrap_or_default(),
             week: args.week.or(cfg.week).unwrap_or(0),
         };
-        Ok((settings, mechanization))
+        Ok((settings, mechanization, align))
     }
 }
 
@@ -734,7 +775,8 @@ where
 
 /// `schuler nav`.
 pub fn run(args: NavArgs) -> Result<()> {
-    let (settings, mechanization) = parse_nav_args(args)?;
+    let (mut settings, mechanization, align) = parse_nav_args(args)?;
+    let align = align.map(|a| a.resolve()).transpose()?;
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
@@ -760,15 +802,41 @@ pub fn run(args: NavArgs) -> Result<()> {
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
     let mech = &mechanization;
+    // With --align: align on the first stages, then start from the aligned state at
+    // the last aligned sample with the estimated biases removed.
+    let mut head = Vec::new();
+    let mut bias = (Vector3::zeros(), Vector3::zeros());
+    if let Some((cfg, noise)) = &align {
+        let samples = super::align::read_stage(&mut reader, cfg.coarse + cfg.fine)?;
+        let a = super::align::align_on(settings.earth, settings.init_pos, &samples, noise, cfg)
+            .with_context(|| format!("aligning {}", settings.imu.display()))?;
+        bar.suspend(|| print!("{}", super::align::summary_text(&a, &[])));
+        super::align::write_outputs(&settings.out, &a)?;
+        settings.init_att = a.state.euler();
+        settings.init_vel = Vector3::zeros();
+        bias = (a.gyro_bias, a.accel_bias);
+        let carrier = samples
+            .partition_point(|s| s.t <= a.t_end + 1e-9)
+            .saturating_sub(1);
+        head = samples[carrier..].to_vec();
+    }
+    let compensate = |r: Result<ImuSample, crate::formats::InputError>| {
+        r.map(|s| ImuSample {
+            dtheta: s.dtheta - bias.0 * s.dt,
+            dvel: s.dvel - bias.1 * s.dt,
+            ..s
+        })
+    };
+    let samples = head.into_iter().map(Ok).chain(&mut reader).map(compensate);
     let mut summary = match settings.earth {
         EarthChoice::Wgs84 => {
             let writer = NavWriter::create_extended(&settings.out, settings.week, &Wgs84)?;
-            navigate_with(Wgs84, &settings, mech, &mut reader, writer, on_sample)
+            navigate_with(Wgs84, &settings, mech, samples, writer, on_sample)
         }
         EarthChoice::Sphere | EarthChoice::SphereFixed => {
             let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
             let writer = NavWriter::create_extended(&settings.out, settings.week, &sphere)?;
-            navigate_with(sphere, &settings, mech, &mut reader, writer, on_sample)
+            navigate_with(sphere, &settings, mech, samples, writer, on_sample)
         }
     }?;
     bar.set_position(reader.bytes_read());

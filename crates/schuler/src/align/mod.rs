@@ -166,6 +166,8 @@ pub struct Alignment {
     pub t_coarse: f64,
     /// End of alignment [s].
     pub t_end: f64,
+    /// Run time of the pre-filter, the coarse and the fine stage [s] (wall clock).
+    pub stage_seconds: [f64; 3],
 }
 
 /// A state the filter reduced to less than this fraction of its prior counts as
@@ -238,11 +240,13 @@ pub fn align<E: EarthModel>(
         return Err(AlignError::NotEnoughData { have, need });
     }
     let end = samples.partition_point(|s| s.t <= t_start + need + 0.5 * dt);
+    let clock = std::time::Instant::now();
     let mut data = samples[..end].to_vec();
     let block = ((cfg.block / dt).round() as usize).max(1);
     let spikes = prefilter::reject_spikes(&mut data, block, cfg.spike_sigmas);
     let motion = prefilter::detect_motion(&data, block, &noise.arw, &noise.vrw);
 
+    let t_pre = clock.elapsed().as_secs_f64();
     let split = data.partition_point(|s| s.t <= t_start + cfg.coarse + 0.5 * dt);
     let (f_b, w_b, t_c) = mean_rates(&data[..split]);
     if f_b.norm() == 0.0 {
@@ -274,6 +278,7 @@ pub fn align<E: EarthModel>(
         .map(|v| v.max(0.0).sqrt());
 
     let t_coarse = t_start + t_c;
+    let t_coarse_run = clock.elapsed().as_secs_f64() - t_pre;
     let mut out = Alignment {
         state: NavState {
             t: t_coarse,
@@ -296,6 +301,7 @@ pub fn align<E: EarthModel>(
         t_start,
         t_coarse,
         t_end: t_coarse,
+        stage_seconds: [t_pre, t_coarse_run, 0.0],
     };
     if cfg.fine <= 0.0 || split >= data.len() {
         return Ok(out);
@@ -350,6 +356,7 @@ pub fn align<E: EarthModel>(
     out.accel_bias = fine.accel_bias;
     out.accel_bias_std = std(Layout::ACCEL_BIAS);
     out.t_end = fine.t_end;
+    out.stage_seconds[2] = clock.elapsed().as_secs_f64() - t_pre - t_coarse_run;
     out.fine = Some(fine);
     Ok(out)
 }
