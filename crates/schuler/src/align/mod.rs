@@ -261,18 +261,30 @@ pub fn align<E: EarthModel>(
     };
     let coarse = CoarseAlignment::from_means(&earth, &pos, f_b, w_b, t_c, cfg.heading)
         .ok_or_else(|| refuse(f64::INFINITY))?;
+    // On a moving base the coarse means carry the motion's net angle and velocity
+    // change over the stage, `Δθ/T` and `Δv/T` (std √2 × wander / T): counted as extra
+    // white noise of the same mean variance, `N² += 2 wander² / T`.
+    let mut coarse_noise = *noise;
+    if motion.angular_motion || motion.vibration {
+        let add = |n: &Vector3<f64>, w: &Vector3<f64>| {
+            Vector3::from_fn(|i, _| (n[i] * n[i] + 2.0 * w[i] * w[i] / t_c).sqrt())
+        };
+        coarse_noise.arw = add(&noise.arw, &motion.attitude_wander);
+        coarse_noise.vrw = add(&noise.vrw, &motion.velocity_wander);
+    }
     // The limit after both stages: the coarse construction averaged over all the data.
     let limit = CoarseAlignment {
         duration: need,
         ..coarse
     };
+    // The fine stage tracks the motion with the gyros: its limit is the sensors'.
     let predicted_limit = limit.predicted_std(&earth, &pos, noise);
     if cfg.heading == HeadingSource::Gyrocompass
         && (predicted_limit.z > cfg.max_heading_std || predicted_limit.z.is_nan())
     {
         return Err(refuse(predicted_limit.z));
     }
-    let (ppsi, _, _) = coarse.error_covariance(&earth, &pos, noise);
+    let (ppsi, _, _) = coarse.error_covariance(&earth, &pos, &coarse_noise);
     let coarse_std = fine::euler_covariance(&coarse.q_bn, &ppsi)
         .diagonal()
         .map(|v| v.max(0.0).sqrt());
@@ -310,12 +322,27 @@ pub fn align<E: EarthModel>(
     let mut still = cfg.stillness;
     still.window = cfg.block;
     if motion.angular_motion {
-        still.attitude_std = still.attitude_std.max(motion.attitude_wander.max());
+        // The base turns: "attitude unchanged" no longer holds; leave it out (a
+        // 1-rad standard deviation carries no information).
+        still.attitude_std = 1.0;
     }
     if motion.angular_motion || motion.vibration {
         still.velocity_std = still.velocity_std.max(motion.velocity_wander.max());
     }
-    let prior = prior_covariance(&coarse, &earth, &pos, noise, &still);
+    let mut prior = prior_covariance(&coarse, &earth, &pos, &coarse_noise, &still);
+    if motion.angular_motion {
+        // The coarse attitude is the stage's mean; at its end the base is off it by
+        // the wander.
+        let w2 = motion.attitude_wander.norm_squared();
+        for i in 0..3 {
+            prior[(Layout::ATT + i, Layout::ATT + i)] += w2;
+        }
+        let r = Layout::core()
+            .with_attitude_ref()
+            .attitude_ref
+            .unwrap_or(15);
+        duplicate_states(&mut prior, Layout::ATT, r, 3);
+    }
     let fine = fine::fine_align(
         earth,
         pos,

@@ -123,7 +123,7 @@ impl<E: EarthModel> ErrorFrame for LocalLevel<E> {
 mod tests {
     use super::*;
     use crate::earth::{Geodetic, Wgs84};
-    use crate::rotation::{rotation_vector_from_quaternion, Euler};
+    use crate::rotation::{Euler, rotation_vector_from_quaternion};
 
     fn q_of(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
         UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*m))
