@@ -1,6 +1,7 @@
 //! One module per `schuler` subcommand: each parses its arguments and wires library
 //! calls to readers and writers.
 
+pub mod aided;
 pub mod align;
 pub mod channel;
 pub mod demo;

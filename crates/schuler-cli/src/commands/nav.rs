@@ -13,6 +13,7 @@
 //! wander with wander azimuth 0; wander → NED by turning velocity, attitude and the
 //! history through the azimuth), so the run continues as if uninterrupted.
 
+use super::aided::{Aiding, AidingOptions};
 use super::align::AlignOptions;
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};
 use crate::output::{NavEpoch, NavWriter};
@@ -241,6 +242,9 @@ pub struct NavArgs {
     /// Alignment options (with --align).
     #[command(flatten)]
     pub alignment: AlignOptions,
+    /// GNSS aiding (with --gnss): the error-state Kalman filter.
+    #[command(flatten)]
+    pub aiding: AidingOptions,
 }
 
 /// The same options as a TOML file.
@@ -266,6 +270,7 @@ struct NavConfig {
     auto_hysteresis: Option<f64>,
     align: Option<bool>,
     alignment: Option<AlignOptions>,
+    aiding: Option<AidingOptions>,
 }
 
 /// Everything `nav` needs, validated.
@@ -309,7 +314,7 @@ impl NavSettings {
     /// Merge flags over the config file and check every value (the mechanization
     /// options are checked and dropped: see [`parse_nav_args`]).
     pub fn from_args(args: NavArgs) -> Result<Self> {
-        parse_nav_args(args).map(|(settings, _, _)| settings)
+        parse_nav_args(args).map(|(settings, ..)| settings)
     }
 }
 
@@ -344,9 +349,17 @@ fn mechanization_settings(args: &NavArgs, cfg: &NavConfig) -> Result<Mechanizati
 /// its mechanization. (The mechanization is kept apart from [`NavSettings`] so that
 /// code building `NavSettings` field by field keeps compiling; it goes to
 /// [`navigate_with`].)
-pub fn parse_nav_args(
-    args: NavArgs,
-) -> Result<(NavSettings, MechanizationSettings, Option<AlignOptions>)> {
+/// A parsed `nav` command line: settings, mechanization, and the optional alignment
+/// and aiding options (not yet resolved).
+pub type NavPlan = (
+    NavSettings,
+    MechanizationSettings,
+    (bool, AlignOptions),
+    AidingOptions,
+);
+
+/// Merge flags over the config file and check every value (see [`NavPlan`]).
+pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
     {
         let cfg = match &args.config {
             Some(p) => load_config(p)?,
@@ -365,15 +378,17 @@ pub fn parse_nav_args(
             bail!("--init-pos: latitude {lat} deg is outside [-90, 90]");
         }
         let Triple(v) = args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3]));
-        let align = (args.align || cfg.align.unwrap_or(false)).then(|| {
+        let align_on = args.align || cfg.align.unwrap_or(false);
+        let align = (
+            align_on,
             args.alignment
                 .clone()
-                .or(cfg.alignment.clone().unwrap_or_default())
-        });
-        let init_att = match (args.init_att.or(cfg.init_att), &align) {
+                .or(cfg.alignment.clone().unwrap_or_default()),
+        );
+        let init_att = match (args.init_att.or(cfg.init_att), align_on) {
             (Some(a), _) => a,
-            (None, Some(_)) => Triple([0.0; 3]),
-            (None, None) => bail!(
+            (None, true) => Triple([0.0; 3]),
+            (None, false) => bail!(
                 "no initial attitude: give --init-att ROLL,PITCH,YAW (deg), or --align to \
                  align at rest first; free-inertial navigation cannot start without one"
             ),
@@ -423,7 +438,16 @@ pub fn parse_nav_args(
             earth: args.earth.or(cfg.earth).unwrap_or_default(),
             week: args.week.or(cfg.week).unwrap_or(0),
         };
-        Ok((settings, mechanization, align))
+        let base = args
+            .config
+            .as_deref()
+            .and_then(Path::parent)
+            .unwrap_or(Path::new(""));
+        let aiding =
+            args.aiding
+                .clone()
+                .or(cfg.aiding.clone().unwrap_or_default().relative_to(base));
+        Ok((settings, mechanization, align, aiding))
     }
 }
 
@@ -625,20 +649,20 @@ impl<E: WanderEarth> Runner for Navigator<E> {
 /// Decides which epochs to write: every one, or the first epoch at or after each
 /// multiple of `1/rate` (a thousandth of a sample interval of tolerance absorbs the
 /// decimal time tags of logs).
-struct Decimator {
+pub(crate) struct Decimator {
     rate: Option<f64>,
     last_slot: f64,
 }
 
 impl Decimator {
-    fn new(rate: Option<f64>) -> Self {
+    pub(crate) fn new(rate: Option<f64>) -> Self {
         Self {
             rate,
             last_slot: f64::NEG_INFINITY,
         }
     }
 
-    fn take(&mut self, t: f64, dt: f64) -> bool {
+    pub(crate) fn take(&mut self, t: f64, dt: f64) -> bool {
         match self.rate {
             None => true,
             Some(r) => {
@@ -775,8 +799,16 @@ where
 
 /// `schuler nav`.
 pub fn run(args: NavArgs) -> Result<()> {
-    let (mut settings, mechanization, align) = parse_nav_args(args)?;
-    let align = align.map(|a| a.resolve()).transpose()?;
+    let (mut settings, mechanization, (align_on, align_opts), aiding_opts) = parse_nav_args(args)?;
+    // --imu-grade serves the alignment and the filter alike.
+    let grade = align_opts.imu_grade.unwrap_or_default();
+    let align = align_on.then(|| align_opts.resolve()).transpose()?;
+    let aiding: Option<Aiding> = aiding_opts.resolve(grade.noise()?)?;
+    if aiding.is_some() && mechanization.choice == MechanizationChoice::Wander {
+        bail!(
+            "GNSS aiding runs on the NED mechanization in this version; use --mechanization ned or auto"
+        );
+    }
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
@@ -828,6 +860,39 @@ pub fn run(args: NavArgs) -> Result<()> {
         })
     };
     let samples = head.into_iter().map(Ok).chain(&mut reader).map(compensate);
+    if let Some(aiding) = &aiding {
+        let summary = match settings.earth {
+            EarthChoice::Wgs84 => {
+                let writer = NavWriter::create_extended(&settings.out, settings.week, &Wgs84)?;
+                super::aided::navigate_aided(Wgs84, &settings, aiding, samples, writer, on_sample)
+            }
+            EarthChoice::Sphere | EarthChoice::SphereFixed => {
+                let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
+                let writer = NavWriter::create_extended(&settings.out, settings.week, &sphere)?;
+                super::aided::navigate_aided(sphere, &settings, aiding, samples, writer, on_sample)
+            }
+        }?;
+        bar.finish_and_clear();
+        let c = summary.counts;
+        let secs = started.elapsed().as_secs_f64();
+        println!(
+            "integrated {} samples with {} GNSS fixes in {:.2} s: {} position and {} velocity updates, {} rejected by the gate, {} outside the IMU data (see rejected.csv); mean NIS per dimension {:.2}",
+            summary.nav.samples,
+            aiding.fixes.len(),
+            secs,
+            c.position,
+            c.velocity,
+            c.rejected,
+            c.skipped,
+            summary.mean_nis_per_dof
+        );
+        println!(
+            "wrote {} epochs to {} (and nav.csv, std.txt, imu_err.txt, rejected.csv)",
+            summary.nav.epochs,
+            settings.out.join("nav.txt").display()
+        );
+        return Ok(());
+    }
     let mut summary = match settings.earth {
         EarthChoice::Wgs84 => {
             let writer = NavWriter::create_extended(&settings.out, settings.week, &Wgs84)?;

@@ -6,6 +6,7 @@
 //! bounded amount of memory whatever the length of the log.
 
 pub mod error;
+pub mod gnss;
 pub mod imu_log;
 mod lines;
 

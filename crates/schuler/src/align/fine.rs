@@ -18,7 +18,7 @@
 //! (indistinguishable from heading); the report says which states the data reduced.
 
 use crate::earth::{EarthModel, Geodetic};
-use crate::filter::error_model::IntervalMeans;
+use crate::filter::interval::Interval;
 use crate::filter::{ErrorModel, Gate, ImuNoise, Kalman, Layout};
 use crate::imu::ImuSample;
 use crate::nav::{ErrorFrame, LocalLevel, Mechanization, NavErrors, NavState};
@@ -141,7 +141,7 @@ pub fn fine_align<E: EarthModel>(
     let mut kf = Kalman::new(prior);
     let mut convergence = Vec::new();
 
-    let mut acc = Window::default();
+    let mut acc = Interval::default();
     let mut v_prev = Vector3::zeros();
     let gate = Gate::Off;
     let r = DMatrix::from_diagonal(&DVector::from_vec(
@@ -215,7 +215,7 @@ pub fn fine_align<E: EarthModel>(
             gyro_bias_std: diag_std(&kf.p, Layout::GYRO_BIAS),
             accel_bias_std: diag_std(&kf.p, Layout::ACCEL_BIAS),
         });
-        acc = Window::default();
+        acc = Interval::default();
     }
     let end = mech.state();
     FineAlignment {
@@ -226,42 +226,5 @@ pub fn fine_align<E: EarthModel>(
         covariance: kf.p,
         prior_std,
         convergence,
-    }
-}
-
-/// Sums over one measurement window.
-#[derive(Debug, Default)]
-struct Window {
-    t: f64,
-    f_c_dt: Vector3<f64>,
-    f_b_dt: Vector3<f64>,
-    w_b_dt: Vector3<f64>,
-    v_dt: Vector3<f64>,
-}
-
-impl Window {
-    fn add(
-        &mut self,
-        s: &ImuSample,
-        q_bn: &UnitQuaternion<f64>,
-        v0: &Vector3<f64>,
-        v1: &Vector3<f64>,
-    ) {
-        self.t += s.dt;
-        self.f_c_dt += q_bn * s.dvel;
-        self.f_b_dt += s.dvel;
-        self.w_b_dt += s.dtheta;
-        self.v_dt += (v0 + v1) * (0.5 * s.dt);
-    }
-
-    fn means(&self, frame: crate::nav::FrameSnapshot) -> IntervalMeans {
-        let t = self.t.max(f64::MIN_POSITIVE);
-        IntervalMeans {
-            dt: self.t,
-            frame,
-            f_c: self.f_c_dt / t,
-            f_b: self.f_b_dt / t,
-            w_b: self.w_b_dt / t,
-        }
     }
 }

@@ -5,15 +5,22 @@
 //! - [`noise`]: the IMU noise model the process noise comes from;
 //! - [`error_model`]: the psi-angle error dynamics `F`, their transition matrix and
 //!   discrete process noise (non-singular at the poles, see [`crate::nav::frame`]);
+//! - [`interval`]: the sums over one propagation interval;
+//! - [`measurement`]: GNSS position and velocity with lever arm;
+//! - [`integration`]: the loosely coupled INS/GNSS filter loop;
 //! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
 //!   innovation gate.
 
 pub mod error_model;
+pub mod integration;
+pub mod interval;
 pub mod kalman;
 pub mod layout;
+pub mod measurement;
 pub mod noise;
 
 pub use error_model::{ErrorModel, IntervalMeans};
+pub use integration::{GnssFix, IntegrationConfig, Integrator, SensorEstimates};
 pub use kalman::{Gate, Kalman, Rejection, Update};
 pub use layout::Layout;
 pub use noise::ImuNoise;

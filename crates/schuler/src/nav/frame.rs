@@ -58,6 +58,8 @@ pub struct NavErrors {
 pub trait ErrorFrame: Mechanization {
     /// The computation frame at the current time.
     fn frame(&self) -> FrameSnapshot;
+    /// The attitude, body to `c` (cheap: no Earth model evaluation).
+    fn q_bc(&self) -> UnitQuaternion<f64>;
     /// Remove estimated errors from the state (closed-loop feedback).
     fn correct(&mut self, errors: &NavErrors);
 }
@@ -92,6 +94,10 @@ impl<E: EarthModel> ErrorFrame for LocalLevel<E> {
             gravity: local.g_n.norm(),
             radius: (local.radii.meridian * local.radii.prime_vertical).sqrt() + s.pos.h,
         }
+    }
+
+    fn q_bc(&self) -> UnitQuaternion<f64> {
+        self.state().q_bn
     }
 
     fn correct(&mut self, errors: &NavErrors) {

@@ -1,0 +1,470 @@
+//! `schuler nav --gnss ...`: INS/GNSS integration with the error-state filter
+//! ([`schuler::filter::Integrator`]) on the NED mechanization. Besides `nav.txt` and
+//! `nav.csv` it writes, at the output rate, `std.txt` (standard deviations) and
+//! `imu_err.txt` (estimated sensor errors) in KF-GINS's column layouts, and at the end
+//! `rejected.csv` (every measurement the gate refused or that fell outside the IMU
+//! data, with time and reason).
+
+use super::nav::{Decimator, MechanizationKind, NavSettings, NavSummary};
+use crate::output::{NavEpoch, NavWriter, push_fixed};
+use anyhow::{Context, Result, bail};
+use nalgebra::Vector3;
+use schuler::earth::EarthModel;
+use schuler::filter::integration::{Counts, SkipReason};
+use schuler::filter::{GnssFix, IntegrationConfig, Integrator, Layout};
+use schuler::imu::ImuSample;
+use schuler::nav::{LocalLevel, NavState};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+const DPH: f64 = 3600.0 * 180.0 / std::f64::consts::PI;
+const MGAL: f64 = 1e5;
+const PPM: f64 = 1e6;
+
+/// What aiding a run has.
+#[derive(Debug, Clone)]
+pub struct Aiding {
+    /// GNSS fixes in time order.
+    pub fixes: Vec<GnssFix>,
+    /// The filter's settings.
+    pub config: IntegrationConfig,
+}
+
+/// What an aided run did, beyond [`NavSummary`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct AidedSummary {
+    /// The navigation summary.
+    pub nav: NavSummary,
+    /// Filter counters.
+    pub counts: Counts,
+    /// Mean normalized innovation squared per dimension of the accepted updates.
+    pub mean_nis_per_dof: f64,
+}
+
+/// Text writer for `std.txt` and `imu_err.txt`.
+struct Table {
+    w: BufWriter<File>,
+    path: PathBuf,
+    line: Vec<u8>,
+}
+
+impl Table {
+    fn create(dir: &Path, name: &str) -> Result<Self> {
+        let path = dir.join(name);
+        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+        Ok(Self {
+            w: BufWriter::with_capacity(1 << 16, f),
+            path,
+            line: Vec::with_capacity(512),
+        })
+    }
+
+    fn row(&mut self, t: f64, values: &[f64]) -> Result<()> {
+        self.line.clear();
+        push_fixed(&mut self.line, t, 6);
+        for v in values {
+            self.line.push(b' ');
+            push_fixed(&mut self.line, *v, 9);
+        }
+        self.line.push(b'\n');
+        self.w
+            .write_all(&self.line)
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+
+    fn finish(mut self) -> Result<()> {
+        self.w
+            .flush()
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+fn std3(p: &nalgebra::DMatrix<f64>, o: usize) -> Vector3<f64> {
+    Vector3::new(p[(o, o)], p[(o + 1, o + 1)], p[(o + 2, o + 2)]).map(|v| v.max(0.0).sqrt())
+}
+
+fn write_epoch<E: EarthModel>(
+    integ: &Integrator<LocalLevel<E>, E>,
+    earth: &E,
+    nav: &mut NavWriter,
+    std: &mut Table,
+    err: &mut Table,
+) -> Result<()> {
+    let state = integ.state();
+    nav.write_epoch(&NavEpoch {
+        state,
+        r_e: earth.geodetic_to_ecef(&state.pos),
+        wander_azimuth: 0.0,
+    })?;
+    let [sp, sv, sa] = integ.nav_std();
+    let p = integ.covariance();
+    let l = integ.layout();
+    let scale = |o: Option<usize>| o.map_or(Vector3::zeros(), |o| std3(p, o));
+    let mut row = Vec::with_capacity(21);
+    row.extend_from_slice(sp.as_slice());
+    row.extend_from_slice(sv.as_slice());
+    row.extend(sa.iter().map(|x| x.to_degrees()));
+    row.extend(std3(p, Layout::GYRO_BIAS).iter().map(|x| x * DPH));
+    row.extend(std3(p, Layout::ACCEL_BIAS).iter().map(|x| x * MGAL));
+    row.extend(scale(l.gyro_scale).iter().map(|x| x * PPM));
+    row.extend(scale(l.accel_scale).iter().map(|x| x * PPM));
+    std.row(state.t, &row)?;
+    let e = integ.estimates();
+    let mut row = Vec::with_capacity(12);
+    row.extend(e.gyro_bias.iter().map(|x| x * DPH));
+    row.extend(e.accel_bias.iter().map(|x| x * MGAL));
+    row.extend(e.gyro_scale.iter().map(|x| x * PPM));
+    row.extend(e.accel_scale.iter().map(|x| x * PPM));
+    err.row(state.t, &row)
+}
+
+fn write_rejections<E: EarthModel>(dir: &Path, integ: &Integrator<LocalLevel<E>, E>) -> Result<()> {
+    let path = dir.join("rejected.csv");
+    let mut s = String::from("t,measurement,reason,nis,threshold\n");
+    let mut rows: Vec<(f64, String)> = integ
+        .rejected
+        .iter()
+        .map(|r| {
+            (
+                r.t,
+                format!(
+                    "{},{},chi-square gate,{},{}\n",
+                    r.t, r.kind, r.rejection.nis, r.rejection.threshold
+                ),
+            )
+        })
+        .collect();
+    rows.extend(integ.skipped.iter().map(|k| {
+        let why = match k.reason {
+            SkipReason::BeforeImu => "before the IMU data",
+            SkipReason::AfterImu => "after the IMU data",
+        };
+        (k.t, format!("{},gnss,{why},,\n", k.t))
+    }));
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, r) in rows {
+        s.push_str(&r);
+    }
+    std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Run the integrated navigation over `samples` (the first carries the initial state)
+/// with the NED mechanization, writing into `settings.out`. On a read error everything
+/// computed so far is written before the error is returned.
+pub fn navigate_aided<E: EarthModel, I>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: &Aiding,
+    mut samples: I,
+    mut writer: NavWriter,
+    mut on_sample: impl FnMut(u64),
+) -> Result<AidedSummary>
+where
+    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+{
+    let first = match samples.next() {
+        Some(s) => s?,
+        None => bail!(
+            "{}: no IMU sample in the requested time window",
+            settings.imu.display()
+        ),
+    };
+    let init = NavState::new(
+        first.t,
+        settings.init_pos,
+        settings.init_vel,
+        settings.init_att,
+    );
+    let mut integ = Integrator::new(LocalLevel::new(earth, init), earth, aiding.config);
+    integ.prime(&first);
+    let mut std = Table::create(&settings.out, "std.txt")?;
+    let mut err = Table::create(&settings.out, "imu_err.txt")?;
+    let mut fixes = aiding.fixes.iter().copied().peekable();
+    let mut decimator = Decimator::new(settings.output_rate);
+    decimator.take(first.t, first.dt);
+    write_epoch(&integ, &earth, &mut writer, &mut std, &mut err)?;
+    let mut n = 0u64;
+    let mut last_t = first.t;
+    let mut failure = None;
+    for s in samples.by_ref() {
+        let s = match s {
+            Ok(s) => s,
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        };
+        integ.step_with_fixes(&s, &mut fixes);
+        n += 1;
+        last_t = s.t;
+        if decimator.take(s.t, s.dt) {
+            write_epoch(&integ, &earth, &mut writer, &mut std, &mut err)?;
+        }
+        if n.is_multiple_of(65_536) {
+            on_sample(n);
+        }
+    }
+    for f in fixes {
+        integ.skip(f.t, SkipReason::AfterImu);
+    }
+    let epochs = writer.finish()?;
+    std.finish()?;
+    err.finish()?;
+    write_rejections(&settings.out, &integ)?;
+    if let Some(e) = failure {
+        return Err(anyhow::Error::new(e).context(format!(
+            "stopped after {n} samples; {epochs} epochs up to t = {last_t} were written to {}",
+            settings.out.display()
+        )));
+    }
+    let (sum, dof) = integ
+        .nis
+        .iter()
+        .fold((0.0, 0usize), |(s, d), (_, _, nis, k)| (s + nis, d + k));
+    Ok(AidedSummary {
+        nav: NavSummary {
+            samples: n,
+            epochs,
+            t_first: first.t,
+            t_last: last_t,
+            last: integ.state(),
+            gaps: None,
+            first_mechanization: MechanizationKind::Ned,
+            handovers: Vec::new(),
+        },
+        counts: integ.counts,
+        mean_nis_per_dof: if dof > 0 { sum / dof as f64 } else { f64::NAN },
+    })
+}
+
+/// The aiding options of `schuler nav`, as written (flags, or a `[aiding]` table in
+/// the TOML config).
+#[derive(clap::Args, Debug, Default, Clone, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AidingOptions {
+    /// GNSS log (KF-GINS text: t lat lon h std_n std_e std_d [vn ve vd std...]).
+    #[arg(long, value_name = "FILE")]
+    pub gnss: Option<PathBuf>,
+    /// GNSS velocity log (t vn ve vd [std_vn std_ve std_vd]) matched to the fixes by time.
+    #[arg(long, value_name = "FILE")]
+    pub gnss_vel: Option<PathBuf>,
+    /// Velocity standard deviation where the velocity log gives none (default 0.1 m/s).
+    #[arg(long, value_name = "SPEED")]
+    pub gnss_vel_std: Option<String>,
+    /// Antenna position in body axes, front, right, down [m].
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub lever_arm: Option<super::nav::Triple>,
+    /// Innovation gate: significance level of the chi-square test (default 1e-4; 0
+    /// turns the gate off).
+    #[arg(long, value_name = "ALPHA")]
+    pub gate: Option<f64>,
+    /// Estimate gyro and accelerometer scale factors (21 states).
+    #[arg(long)]
+    #[serde(default)]
+    pub scale_factors: bool,
+    /// Angle random walk (e.g. `0.1 deg/sqrt(h)`; default from --imu-grade).
+    #[arg(long, value_name = "ARW")]
+    pub arw: Option<String>,
+    /// Velocity random walk (e.g. `0.08 m/s/sqrt(h)`).
+    #[arg(long, value_name = "VRW")]
+    pub vrw: Option<String>,
+    /// Gyro bias standard deviation (e.g. `2 deg/h`).
+    #[arg(long, value_name = "RATE")]
+    pub gyro_bias_std: Option<String>,
+    /// Accelerometer bias standard deviation (e.g. `300 mGal`).
+    #[arg(long, value_name = "ACCEL")]
+    pub accel_bias_std: Option<String>,
+    /// Gyro scale-factor standard deviation (e.g. `1000 ppm`; with --scale-factors).
+    #[arg(long, value_name = "RATIO")]
+    pub gyro_scale_std: Option<String>,
+    /// Accelerometer scale-factor standard deviation.
+    #[arg(long, value_name = "RATIO")]
+    pub accel_scale_std: Option<String>,
+    /// Bias instability (Gauss–Markov std, e.g. `0.2 deg/h` and `2e-4 m/s^2`) with
+    /// --bias-corr-time: sets the bias random walk.
+    #[arg(long, value_name = "RATE")]
+    pub gyro_bias_instability: Option<String>,
+    /// Accelerometer bias instability.
+    #[arg(long, value_name = "ACCEL")]
+    pub accel_bias_instability: Option<String>,
+    /// Correlation time of the bias instability (default 1 h).
+    #[arg(long, value_name = "TIME")]
+    pub bias_corr_time: Option<String>,
+    /// Initial position standard deviation north, east, down [m] (default 1,1,1).
+    #[arg(long, value_name = "N,E,D")]
+    pub init_pos_std: Option<super::nav::Triple>,
+    /// Initial velocity standard deviation [m/s] (default 0.1,0.1,0.1).
+    #[arg(long, value_name = "N,E,D")]
+    pub init_vel_std: Option<super::nav::Triple>,
+    /// Initial attitude standard deviation roll, pitch, yaw [deg] (default 0.1,0.1,0.5).
+    #[arg(long, value_name = "R,P,Y")]
+    pub init_att_std: Option<super::nav::Triple>,
+    /// Longest covariance propagation step (default 1 s; the covariance is always
+    /// propagated to each measurement's time).
+    #[arg(long, value_name = "TIME")]
+    pub propagation_interval: Option<String>,
+}
+
+impl AidingOptions {
+    /// `self` with missing fields taken from `other`.
+    pub fn or(self, other: AidingOptions) -> AidingOptions {
+        macro_rules! pick {
+            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors } };
+        }
+        pick!(
+            gnss,
+            gnss_vel,
+            gnss_vel_std,
+            lever_arm,
+            gate,
+            arw,
+            vrw,
+            gyro_bias_std,
+            accel_bias_std,
+            gyro_scale_std,
+            accel_scale_std,
+            gyro_bias_instability,
+            accel_bias_instability,
+            bias_corr_time,
+            init_pos_std,
+            init_vel_std,
+            init_att_std,
+            propagation_interval
+        )
+    }
+
+    /// Paths relative to `base` (a config file's folder).
+    pub fn relative_to(mut self, base: &Path) -> Self {
+        for p in [&mut self.gnss, &mut self.gnss_vel].into_iter().flatten() {
+            if p.is_relative() {
+                *p = base.join(&*p);
+            }
+        }
+        self
+    }
+
+    /// Load the GNSS data and check every value; `None` without `--gnss`.
+    pub fn resolve(&self, noise: schuler::filter::ImuNoise) -> Result<Option<Aiding>> {
+        use schuler::units::{Dimension, parse_as_or_si};
+        let Some(gnss) = &self.gnss else {
+            if self.gnss_vel.is_some() {
+                bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
+            }
+            return Ok(None);
+        };
+        let q = |flag: &str, v: &Option<String>, dim: Dimension| -> Result<Option<f64>> {
+            let Some(s) = v else { return Ok(None) };
+            let x = parse_as_or_si(s, dim).with_context(|| format!("--{flag} {s:?}"))?;
+            if !(x.is_finite() && x >= 0.0) {
+                bail!("--{flag} must not be negative, got {s:?}");
+            }
+            Ok(Some(x))
+        };
+        let mut fixes = crate::formats::gnss::read_gnss(gnss)?;
+        if let Some(v) = &self.gnss_vel {
+            let std = q("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
+            if std <= 0.0 {
+                bail!("--gnss-vel-std must be positive");
+            }
+            let unmatched = crate::formats::gnss::merge_velocity(&mut fixes, v, std)?;
+            if unmatched > 0 {
+                eprintln!(
+                    "warning: {}: {unmatched} velocity epochs have no position fix at the same time and are not used",
+                    v.display()
+                );
+            }
+        }
+        let mut noise = noise;
+        if let Some(x) = q("arw", &self.arw, Dimension::AngleRandomWalk)? {
+            noise.arw = Vector3::repeat(x);
+        }
+        if let Some(x) = q("vrw", &self.vrw, Dimension::VelocityRandomWalk)? {
+            noise.vrw = Vector3::repeat(x);
+        }
+        if let Some(x) = q("gyro-bias-std", &self.gyro_bias_std, Dimension::AngularRate)? {
+            noise.gyro_bias = Vector3::repeat(x);
+        }
+        if let Some(x) = q(
+            "accel-bias-std",
+            &self.accel_bias_std,
+            Dimension::Acceleration,
+        )? {
+            noise.accel_bias = Vector3::repeat(x);
+        }
+        if let Some(x) = q(
+            "gyro-scale-std",
+            &self.gyro_scale_std,
+            Dimension::Dimensionless,
+        )? {
+            noise.gyro_scale = Vector3::repeat(x);
+        }
+        if let Some(x) = q(
+            "accel-scale-std",
+            &self.accel_scale_std,
+            Dimension::Dimensionless,
+        )? {
+            noise.accel_scale = Vector3::repeat(x);
+        }
+        let tau = q("bias-corr-time", &self.bias_corr_time, Dimension::Time)?.unwrap_or(3600.0);
+        if tau <= 0.0 {
+            bail!("--bias-corr-time must be positive");
+        }
+        if let Some(x) = q(
+            "gyro-bias-instability",
+            &self.gyro_bias_instability,
+            Dimension::AngularRate,
+        )? {
+            noise.gyro_bias_walk = Vector3::repeat(x * (2.0 / tau).sqrt());
+        }
+        if let Some(x) = q(
+            "accel-bias-instability",
+            &self.accel_bias_instability,
+            Dimension::Acceleration,
+        )? {
+            noise.accel_bias_walk = Vector3::repeat(x * (2.0 / tau).sqrt());
+        }
+        let gate = match self.gate {
+            None => schuler::filter::Gate::Level(1e-4),
+            Some(0.0) => schuler::filter::Gate::Off,
+            Some(a) if a > 0.0 && a < 1.0 => schuler::filter::Gate::Level(a),
+            Some(a) => bail!("--gate must be a significance level in [0, 1), got {a}"),
+        };
+        let triple = |flag: &str,
+                      v: &Option<super::nav::Triple>,
+                      default: [f64; 3]|
+         -> Result<Vector3<f64>> {
+            let t = v.map_or(default, |t| t.0);
+            if t.iter().any(|x| *x <= 0.0) {
+                bail!("--{flag} must be positive, got {t:?}");
+            }
+            Ok(Vector3::from(t))
+        };
+        let att = triple("init-att-std", &self.init_att_std, [0.1, 0.1, 0.5])?;
+        let propagation_interval = q(
+            "propagation-interval",
+            &self.propagation_interval,
+            Dimension::Time,
+        )?
+        .unwrap_or(1.0);
+        if propagation_interval <= 0.0 {
+            bail!("--propagation-interval must be positive");
+        }
+        Ok(Some(Aiding {
+            fixes,
+            config: IntegrationConfig {
+                noise,
+                scale_factors: self.scale_factors,
+                lever_arm: self
+                    .lever_arm
+                    .map_or(Vector3::zeros(), |t| Vector3::from(t.0)),
+                gate,
+                propagation_interval,
+                init_pos_std: triple("init-pos-std", &self.init_pos_std, [1.0, 1.0, 1.0])?,
+                init_vel_std: triple("init-vel-std", &self.init_vel_std, [0.1, 0.1, 0.1])?,
+                // Roll, pitch, yaw std taken about north, east, down (level attitude).
+                init_att_std: att.map(f64::to_radians),
+            },
+        }))
+    }
+}

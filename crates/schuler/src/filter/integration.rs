@@ -1,0 +1,400 @@
+//! Loosely coupled INS/GNSS integration: the mechanization, its error-state filter
+//! with closed-loop feedback, GNSS measurements at their own times, gating and the
+//! record of every rejection.
+//!
+//! Each IMU sample is compensated with the sensor errors estimated so far
+//! (`dθ' = (dθ − b_g dt) ⊙ (1 − s_g)`, the same for `dv`), mechanized, and summed into
+//! the current propagation interval; the covariance is propagated when the interval
+//! reaches [`IntegrationConfig::propagation_interval`] and before every update. A GNSS
+//! fix that falls inside a sample's interval splits the sample there (increments
+//! divided in proportion to time, the constant-rate assumption over one sample), so
+//! the update happens at the fix's own time.
+
+use super::error_model::ErrorModel;
+use super::interval::Interval;
+use super::kalman::{Gate, Kalman, Rejection};
+use super::layout::Layout;
+use super::measurement::{self, Kind, Measurement};
+use super::noise::ImuNoise;
+use crate::earth::{EarthModel, Geodetic};
+use crate::imu::ImuSample;
+use crate::nav::{ErrorFrame, NavErrors, NavState};
+use nalgebra::{DMatrix, Matrix3, Vector3};
+
+/// One GNSS epoch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GnssFix {
+    /// Time [s].
+    pub t: f64,
+    /// Antenna position.
+    pub pos: Geodetic,
+    /// Position standard deviations north, east, down [m].
+    pub pos_std: Vector3<f64>,
+    /// Velocity north, east, down [m/s] and its standard deviations, if measured.
+    pub vel: Option<(Vector3<f64>, Vector3<f64>)>,
+}
+
+/// Filter settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegrationConfig {
+    /// IMU noise and bias statistics.
+    pub noise: ImuNoise,
+    /// Estimate gyro and accelerometer scale factors (21 states).
+    pub scale_factors: bool,
+    /// GNSS antenna position in body axes (FRD) [m].
+    pub lever_arm: Vector3<f64>,
+    /// Innovation gate.
+    pub gate: Gate,
+    /// Longest covariance propagation step [s].
+    pub propagation_interval: f64,
+    /// Initial standard deviations: position (NED) [m].
+    pub init_pos_std: Vector3<f64>,
+    /// Initial velocity standard deviations (NED) [m/s].
+    pub init_vel_std: Vector3<f64>,
+    /// Initial attitude standard deviations (about north, east, down) [rad].
+    pub init_att_std: Vector3<f64>,
+}
+
+/// A measurement the gate refused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rejected {
+    /// Time [s].
+    pub t: f64,
+    /// What it was.
+    pub kind: Kind,
+    /// Why: the test's numbers.
+    pub rejection: Rejection,
+}
+
+/// A measurement that could not be used at all.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Skipped {
+    /// Time [s].
+    pub t: f64,
+    /// Why.
+    pub reason: SkipReason,
+}
+
+/// Why a measurement was not used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SkipReason {
+    /// Its time is before the IMU data being processed.
+    BeforeImu,
+    /// Its time is after the IMU data ended.
+    AfterImu,
+}
+
+/// Estimated sensor errors (what the compensation removes).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SensorEstimates {
+    /// Gyro bias [rad/s].
+    pub gyro_bias: Vector3<f64>,
+    /// Accelerometer bias [m/s^2].
+    pub accel_bias: Vector3<f64>,
+    /// Gyro scale-factor error.
+    pub gyro_scale: Vector3<f64>,
+    /// Accelerometer scale-factor error.
+    pub accel_scale: Vector3<f64>,
+}
+
+impl SensorEstimates {
+    /// The sample with these errors removed.
+    pub fn compensate(&self, s: &ImuSample) -> ImuSample {
+        let one = Vector3::repeat(1.0);
+        ImuSample {
+            dtheta: (s.dtheta - self.gyro_bias * s.dt).component_mul(&(one - self.gyro_scale)),
+            dvel: (s.dvel - self.accel_bias * s.dt).component_mul(&(one - self.accel_scale)),
+            ..*s
+        }
+    }
+}
+
+/// Counts of what the filter did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Counts {
+    /// Accepted position updates.
+    pub position: u64,
+    /// Accepted velocity updates.
+    pub velocity: u64,
+    /// Rejected by the gate.
+    pub rejected: u64,
+    /// Not usable (outside the IMU's time span).
+    pub skipped: u64,
+}
+
+/// The integrated navigation: mechanization plus filter.
+#[derive(Debug, Clone)]
+pub struct Integrator<M: ErrorFrame, E: EarthModel> {
+    mech: M,
+    earth: E,
+    model: ErrorModel,
+    kf: Kalman,
+    cfg: IntegrationConfig,
+    interval: Interval,
+    estimates: SensorEstimates,
+    w_ib_b: Vector3<f64>,
+    /// Gate decisions, in time order.
+    pub rejected: Vec<Rejected>,
+    /// Measurements outside the IMU span, in time order.
+    pub skipped: Vec<Skipped>,
+    /// Normalized innovations of accepted updates: time, kind, NIS, dimension.
+    pub nis: Vec<(f64, Kind, f64, usize)>,
+    /// Counters.
+    pub counts: Counts,
+}
+
+fn block(p: &DMatrix<f64>, o: usize) -> Matrix3<f64> {
+    p.fixed_view::<3, 3>(o, o).into_owned()
+}
+
+impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
+    /// Start from a mechanization at its initial state.
+    pub fn new(mech: M, earth: E, cfg: IntegrationConfig) -> Self {
+        let mut layout = Layout::core();
+        if cfg.scale_factors {
+            layout = layout.with_scale_factors();
+        }
+        let model = ErrorModel {
+            layout,
+            noise: cfg.noise,
+            baro_bias_walk: 0.0,
+        };
+        let frame = mech.frame();
+        let state = mech.state();
+        let c = measurement::c_nc(&frame, &state.pos);
+        let mut p =
+            model.initial_covariance(Vector3::zeros(), Vector3::zeros(), Vector3::zeros(), 0.0);
+        let rot = |std: &Vector3<f64>| {
+            c * Matrix3::from_diagonal(&std.component_mul(std)) * c.transpose()
+        };
+        for (o, std) in [
+            (Layout::POS, cfg.init_pos_std),
+            (Layout::VEL, cfg.init_vel_std),
+            (Layout::ATT, cfg.init_att_std),
+        ] {
+            p.fixed_view_mut::<3, 3>(o, o).copy_from(&rot(&std));
+        }
+        Self {
+            mech,
+            earth,
+            model,
+            kf: Kalman::new(p),
+            cfg,
+            interval: Interval::default(),
+            estimates: SensorEstimates::default(),
+            w_ib_b: Vector3::zeros(),
+            rejected: Vec::new(),
+            skipped: Vec::new(),
+            nis: Vec::new(),
+            counts: Counts::default(),
+        }
+    }
+
+    /// The mechanization (current state).
+    pub fn mechanization(&self) -> &M {
+        &self.mech
+    }
+
+    /// The state now.
+    pub fn state(&self) -> NavState {
+        self.mech.state()
+    }
+
+    /// Estimated sensor errors.
+    pub fn estimates(&self) -> SensorEstimates {
+        self.estimates
+    }
+
+    /// The state layout.
+    pub fn layout(&self) -> Layout {
+        self.model.layout
+    }
+
+    /// The error covariance (as of the last propagation or update).
+    pub fn covariance(&self) -> &DMatrix<f64> {
+        &self.kf.p
+    }
+
+    /// Standard deviations of position and velocity in NED and of the attitude error
+    /// about north, east, down, from the covariance.
+    pub fn nav_std(&self) -> [Vector3<f64>; 3] {
+        let frame = self.mech.frame();
+        let c = measurement::c_nc(&frame, &self.mech.state().pos).transpose();
+        let p = &self.kf.p;
+        let ned = |o: usize| {
+            (c * block(p, o) * c.transpose())
+                .diagonal()
+                .map(|v| v.max(0.0).sqrt())
+        };
+        [ned(Layout::POS), ned(Layout::VEL), ned(Layout::ATT)]
+    }
+
+    /// Prime the two-sample corrections with the sample that ends at the start.
+    pub fn prime(&mut self, s: &ImuSample) {
+        self.mech.prime(&self.estimates.compensate(s));
+    }
+
+    /// Mechanize one sample (no measurement inside it).
+    pub fn step(&mut self, raw: &ImuSample) {
+        let s = self.estimates.compensate(raw);
+        let q_bc = self.mech.q_bc();
+        let v0 = self.mech.state().v_n;
+        self.mech.step(&s);
+        let v1 = self.mech.state().v_n;
+        self.interval.add(&s, &q_bc, &v0, &v1);
+        if s.dt > 0.0 {
+            self.w_ib_b = s.dtheta / s.dt;
+        }
+        if self.interval.t >= self.cfg.propagation_interval {
+            self.propagate();
+        }
+    }
+
+    /// Propagate the covariance over the accumulated interval.
+    pub fn propagate(&mut self) {
+        if self.interval.t <= 0.0 {
+            return;
+        }
+        let means = self.interval.means(self.mech.frame());
+        let (phi, qd) = self.model.transition(&means);
+        self.kf.predict(&phi, &qd);
+        self.interval = Interval::default();
+    }
+
+    /// Mechanize a sample during which GNSS fixes may fall: fixes from `fixes` with
+    /// times up to the sample's end are applied at their own times.
+    pub fn step_with_fixes<I: Iterator<Item = GnssFix>>(
+        &mut self,
+        raw: &ImuSample,
+        fixes: &mut std::iter::Peekable<I>,
+    ) {
+        let tol = 1e-3 * raw.dt.max(1e-9);
+        let mut rest = Some(*raw);
+        while let Some(&f) = fixes.peek() {
+            let now = self.mech.state().t;
+            if f.t < now - tol {
+                fixes.next();
+                self.skip(f.t, SkipReason::BeforeImu);
+                continue;
+            }
+            if f.t <= now + tol {
+                fixes.next();
+                self.update_gnss(&f);
+                continue;
+            }
+            let Some(r) = rest else { break };
+            if f.t > r.t + tol {
+                break;
+            }
+            fixes.next();
+            if f.t < r.t - tol {
+                let (a, b) = split(&r, f.t);
+                self.step(&a);
+                rest = Some(b);
+            } else {
+                self.step(&r);
+                rest = None;
+            }
+            self.update_gnss(&f);
+        }
+        if let Some(r) = rest {
+            self.step(&r);
+        }
+    }
+
+    /// Record a measurement that could not be used.
+    pub fn skip(&mut self, t: f64, reason: SkipReason) {
+        self.counts.skipped += 1;
+        self.skipped.push(Skipped { t, reason });
+    }
+
+    /// Apply a GNSS fix now (position, then velocity if present).
+    pub fn update_gnss(&mut self, fix: &GnssFix) {
+        self.propagate();
+        let lever = self.cfg.lever_arm;
+        let layout = self.model.layout;
+        let m = measurement::gnss_position(
+            &self.earth,
+            &layout,
+            &self.mech.frame(),
+            &fix.pos,
+            &fix.pos_std,
+            &lever,
+        );
+        self.apply(fix.t, m);
+        if let Some((v, std)) = fix.vel {
+            let m = measurement::gnss_velocity(
+                &layout,
+                &self.mech.frame(),
+                &fix.pos,
+                &v,
+                &std,
+                &lever,
+                &self.w_ib_b,
+            );
+            self.apply(fix.t, m);
+        }
+    }
+
+    /// Gate a measurement and, if accepted, update and feed back.
+    pub fn apply(&mut self, t: f64, m: Measurement) -> bool {
+        match self.kf.update(&m.z, &m.h, &m.r, self.cfg.gate) {
+            Ok(u) => {
+                self.nis.push((t, m.kind, u.nis, m.z.len()));
+                match m.kind {
+                    Kind::GnssPosition => self.counts.position += 1,
+                    Kind::GnssVelocity => self.counts.velocity += 1,
+                }
+                self.feed_back(&u.dx);
+                true
+            }
+            Err(rejection) => {
+                self.counts.rejected += 1;
+                self.rejected.push(Rejected {
+                    t,
+                    kind: m.kind,
+                    rejection,
+                });
+                false
+            }
+        }
+    }
+
+    fn feed_back(&mut self, dx: &nalgebra::DVector<f64>) {
+        let v3 = |o: usize| Vector3::new(dx[o], dx[o + 1], dx[o + 2]);
+        self.mech.correct(&NavErrors {
+            dr: v3(Layout::POS),
+            dv: v3(Layout::VEL),
+            psi: v3(Layout::ATT),
+        });
+        let l = self.model.layout;
+        self.estimates.gyro_bias += v3(Layout::GYRO_BIAS);
+        self.estimates.accel_bias += v3(Layout::ACCEL_BIAS);
+        if let Some(o) = l.gyro_scale {
+            self.estimates.gyro_scale += v3(o);
+        }
+        if let Some(o) = l.accel_scale {
+            self.estimates.accel_scale += v3(o);
+        }
+    }
+}
+
+/// Split a sample at time `t` inside its interval: increments in proportion to time.
+pub fn split(s: &ImuSample, t: f64) -> (ImuSample, ImuSample) {
+    let t0 = s.t - s.dt;
+    let k = ((t - t0) / s.dt).clamp(0.0, 1.0);
+    (
+        ImuSample {
+            t,
+            dt: t - t0,
+            dtheta: s.dtheta * k,
+            dvel: s.dvel * k,
+        },
+        ImuSample {
+            t: s.t,
+            dt: s.t - t,
+            dtheta: s.dtheta * (1.0 - k),
+            dvel: s.dvel * (1.0 - k),
+        },
+    )
+}
