@@ -145,7 +145,8 @@ fn attitude_rms_and_outage_max(nav: &Path, truth: &Path) -> ([f64; 3], f64) {
             let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
             let radii = Wgs84.radii(truth.lat);
             let dn = (r[2] - t[2]).to_radians() * (radii.meridian + truth.h);
-            let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
+            let de =
+                (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
             outage = outage.max(dn.hypot(de));
         }
     }
@@ -156,7 +157,12 @@ fn attitude_rms_and_outage_max(nav: &Path, truth: &Path) -> ([f64; 3], f64) {
 /// simulated, initial bias std 2 deg/h and 300 mGal, GNSS std from the file) gives
 /// 1.86 / 11.50 m horizontal RMS / max, 1.35 m vertical max, 11.50 m in the outage,
 /// roll/pitch RMS 0.014 deg, yaw RMS 0.055 deg. The same set-up through
-/// `schuler nav --gnss` must do at least as well, to the digits KF-GINS printed.
+/// `schuler nav --gnss` must do at least as well, to the digits KF-GINS printed
+/// (measured: 1.762 / 10.835 m, 1.351 m, 10.835 m, 0.0139 / 0.0127 deg, 0.0530 deg).
+/// KF-GINS built from its repository (f39bc2e) with these very settings and its scale
+/// factors off gives 1.756 / 10.80 m, 1.351 m, yaw RMS 0.053 deg, as schuler does with
+/// `--propagation-interval 0.01` (KF-GINS propagates at every IMU sample); the default
+/// 1-s propagation costs 0.3 % in horizontal RMS.
 #[test]
 fn gnss_aided_is_at_least_as_accurate_as_kf_gins() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -210,8 +216,8 @@ fn gnss_aided_is_at_least_as_accurate_as_kf_gins() {
     assert!(e.horizontal_rms <= 1.86, "{}", e.horizontal_rms);
     assert!(e.horizontal_max <= 11.50, "{}", e.horizontal_max);
     assert!(outage <= 11.50, "{outage}");
-    assert!(e.vertical_max <= 1.36, "{}", e.vertical_max);
-    assert!(att[0] <= 0.0145 && att[1] <= 0.0145, "{att:?}");
+    assert!(e.vertical_max < 1.355, "{}", e.vertical_max);
+    assert!(att[0] < 0.0145 && att[1] < 0.0145, "{att:?}");
     assert!(att[2] <= 0.0555, "{att:?}");
     // Every fix used or accounted for: 469 in the IMU span, the one at t = 0 before it.
     let rejected = std::fs::read_to_string(out.join("rejected.csv")).expect("rejected.csv");

@@ -288,7 +288,8 @@ pub struct AidingOptions {
     /// Accelerometer bias instability.
     #[arg(long, value_name = "ACCEL")]
     pub accel_bias_instability: Option<String>,
-    /// Correlation time of the bias instability (default 1 h).
+    /// Correlation time of the bias instability (default 1 h); given, the biases are
+    /// modelled as first-order Gauss–Markov processes, otherwise as random walks.
     #[arg(long, value_name = "TIME")]
     pub bias_corr_time: Option<String>,
     /// Initial position standard deviation north, east, down [m] (default 1,1,1).
@@ -406,9 +407,15 @@ impl AidingOptions {
         )? {
             noise.accel_scale = Vector3::repeat(x);
         }
-        let tau = q("bias-corr-time", &self.bias_corr_time, Dimension::Time)?.unwrap_or(3600.0);
+        let tau_given = q("bias-corr-time", &self.bias_corr_time, Dimension::Time)?;
+        let tau = tau_given.unwrap_or(3600.0);
         if tau <= 0.0 {
             bail!("--bias-corr-time must be positive");
+        }
+        if tau_given.is_some() {
+            // A correlation time makes the biases Gauss–Markov (as KF-GINS models them).
+            noise.gyro_bias_tau = tau;
+            noise.accel_bias_tau = tau;
         }
         if let Some(x) = q(
             "gyro-bias-instability",

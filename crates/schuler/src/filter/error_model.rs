@@ -5,7 +5,8 @@
 //! - `δv̇ = G δr − (2ω_ie + ρ)×δv + f^c×ψ + Ĉ_cb (δb_a + diag(f^b) δs_a)`,
 //!   `G = (g/r) diag(−1, −1, 2)` (gravity gradient, down positive)
 //! - `ψ̇ = −(ω_ie + ρ)×ψ − Ĉ_cb (δb_g + diag(ω^b) δs_g)`
-//! - residual biases: random walks ([`super::noise`]); scale factors, the baro bias and
+//! - residual biases: random walks or Gauss–Markov, `ḃ = −b/τ + w` ([`super::noise`]);
+//!   scale factors, the baro bias and
 //!   the reference attitude: constants (the baro bias with an optional walk).
 //!
 //! `ρ` is the transport rate of `c` (with zero vertical component in the wander frame),
@@ -74,6 +75,10 @@ impl ErrorModel {
         put(&mut a, v, Layout::ACCEL_BIAS, &c_bc);
         put(&mut a, att, att, &(-skew(&(f.w_ie_c + f.rho_c))));
         put(&mut a, att, Layout::GYRO_BIAS, &(-c_bc));
+        for i in 0..3 {
+            a[(Layout::GYRO_BIAS + i, Layout::GYRO_BIAS + i)] = -1.0 / self.noise.gyro_bias_tau;
+            a[(Layout::ACCEL_BIAS + i, Layout::ACCEL_BIAS + i)] = -1.0 / self.noise.accel_bias_tau;
+        }
         if let Some(sg) = l.gyro_scale {
             put(&mut a, att, sg, &(-c_bc * Matrix3::from_diagonal(&m.w_b)));
         }

@@ -1,10 +1,12 @@
 //! The IMU noise model of the filter: white noise densities and bias statistics.
 //!
-//! Biases are modelled as a random constant plus a random walk whose rate matches
-//! the simulated first-order Gauss–Markov instability over times short against its
-//! correlation time `τ`: `E[(b(t) − b(0))²] = 2σ²(1 − e^{−t/τ}) ≈ (2σ²/τ) t`
-//! (so the driving density is `2σ²/τ`). The prior is the total of constant, turn-on and
-//! instability variances.
+//! Biases are modelled either as a random constant plus a random walk whose rate
+//! matches a first-order Gauss–Markov instability over times short against its
+//! correlation time `τ`: `E[(b(t) − b(0))²] = 2σ²(1 − e^{−t/τ}) ≈ (2σ²/τ) t` (driving
+//! density `2σ²/τ`; `*_bias_tau` infinite, the default for a sensor model whose
+//! constant and turn-on parts dominate), or as the Gauss–Markov process itself,
+//! `ḃ = −b/τ + w` with the same density (finite `τ`, as KF-GINS models them). The prior
+//! is the total of constant, turn-on and instability variances.
 
 use crate::sim::imu_model::{ImuModel, TriadModel};
 use nalgebra::Vector3;
@@ -24,6 +26,10 @@ pub struct ImuNoise {
     pub accel_bias: Vector3<f64>,
     /// Accelerometer bias random-walk density [m/s^2/sqrt(s)].
     pub accel_bias_walk: Vector3<f64>,
+    /// Gauss–Markov correlation time of the gyro bias [s] (infinite: random walk).
+    pub gyro_bias_tau: f64,
+    /// Gauss–Markov correlation time of the accelerometer bias [s].
+    pub accel_bias_tau: f64,
     /// Prior standard deviation of the gyro scale-factor error.
     pub gyro_scale: Vector3<f64>,
     /// Prior standard deviation of the accelerometer scale-factor error.
@@ -58,6 +64,8 @@ impl ImuNoise {
             gyro_bias_walk: walk(&m.gyro),
             accel_bias: prior(&m.accel),
             accel_bias_walk: walk(&m.accel),
+            gyro_bias_tau: f64::INFINITY,
+            accel_bias_tau: f64::INFINITY,
             gyro_scale: m.gyro.scale.abs(),
             accel_scale: m.accel.scale.abs(),
         }
