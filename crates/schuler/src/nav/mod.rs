@@ -13,6 +13,7 @@
 //! [`Wander::to_local_level`]).
 
 pub mod local_level;
+pub mod platform;
 pub mod state;
 pub mod strapdown;
 pub mod wander;

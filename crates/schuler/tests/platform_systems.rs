@@ -1,0 +1,331 @@
+//! Lecture 22's systems on simulated truth (`schuler::nav::platform`): perfect
+//! instruments, leveling with biased accelerometers through a turn, the Schuler
+//! period, the platform's vertical rate in each azimuth mechanization, and the
+//! gyro-free INS's error growth. Truth comes from the trajectories' exact kinematics
+//! and from the textbook's closed forms (SEEDS.md (20), (22)).
+
+use nalgebra::{Vector3, Vector6};
+use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
+use schuler::nav::NavState;
+use schuler::nav::platform::compare::{CompareConfig, Comparison, SystemKind, compare};
+use schuler::nav::platform::{
+    AccelerometerArray, Azimuth, InstrumentErrors, PlatformIns, TruthPoint, VerticalChannel,
+};
+use schuler::rotation::Euler;
+use schuler::sim::analytic::{Maneuvering, Stationary, Trajectory};
+use schuler::sim::jet::{Jet, JetMat3, JetVec3};
+use std::f64::consts::{PI, TAU};
+
+fn config(systems: Vec<SystemKind>) -> CompareConfig {
+    CompareConfig {
+        errors: InstrumentErrors::default(),
+        gyro_free_array: AccelerometerArray::cube(0.5).expect("regular"),
+        gyro_free_biases: Vector6::zeros(),
+        leveled: false,
+        vertical: VerticalChannel::Free,
+        step: 0.05,
+        imu_rate: 200.0,
+        output_interval: 10.0,
+        systems,
+    }
+}
+
+fn max_of(c: &Comparison, s: usize, f: impl Fn(&schuler::nav::platform::NavError) -> f64) -> f64 {
+    c.errors[s].iter().map(f).fold(0.0, f64::max)
+}
+
+/// Perfect instruments, 30 min of the maneuvering flight (turns, climbs, +-25 deg roll)
+/// on WGS84 with a free vertical channel: every system follows the truth. Bounds are
+/// a few times the measured errors, each with its origin:
+/// - platform and analytic INS, RK4 at 0.05 s on motion with 23 s periods (local error
+///   ~ (w dt)^5): measured <= 3.3e-7 m, 5.3e-10 m/s, 6e-14 rad;
+/// - SINS, the two-sample algorithm at 200 Hz (its own test `strapdown_exact` finds 7 um
+///   on a similar flight): measured 3.5e-5 m, 5.4e-8 m/s, 1e-11 rad;
+/// - gyro-free: the attitude integrates the angular acceleration twice, so round-off
+///   in the gravitation differences (1e-15 of g over 1 m, 1e-14 rad/s^2) grows as t^2
+///   (2e-8 rad in 30 min at most): measured 3.2e-4 m, 2.6e-7 m/s, 1.4e-10 rad.
+#[test]
+fn perfect_instruments_reproduce_the_truth() {
+    let traj = Maneuvering::flight(Geodetic::from_degrees(45.0, 10.0, 1000.0));
+    let c = compare(Wgs84, &traj, 0.0, 1800.0, &config(SystemKind::ALL.to_vec())).expect("runs");
+    for (s, kind) in c.systems.iter().enumerate() {
+        let p = max_of(&c, s, |e| e.pos_ned.norm());
+        let v = max_of(&c, s, |e| e.v_ned.norm());
+        let a = max_of(&c, s, |e| e.attitude.norm());
+        let (pb, vb, ab) = match kind {
+            SystemKind::Sins => (2e-4, 3e-7, 5e-11),
+            SystemKind::GyroFree => (3e-3, 3e-6, 2e-8),
+            _ => (2e-6, 3e-9, 1e-12),
+        };
+        println!(
+            "{:14} pos {p:.2e} m  vel {v:.2e} m/s  att {a:.2e} rad",
+            kind.name()
+        );
+        assert!(
+            p < pb && v < vb && a < ab,
+            "{}: {p:e} {v:e} {a:e}",
+            kind.name()
+        );
+    }
+}
+
+/// At rest, turning on the spot by `angle` between `start` and `start + duration`
+/// (heading `angle (s − sin(2 pi s)/(2 pi))`, smooth to the angular acceleration).
+struct TurnOnSpot {
+    pos: Geodetic,
+    start: f64,
+    duration: f64,
+    angle: f64,
+}
+
+impl Trajectory for TurnOnSpot {
+    fn position(&self, _t: Jet) -> JetVec3 {
+        [self.pos.lat, self.pos.lon, self.pos.h].map(Jet::constant)
+    }
+    fn c_bn(&self, t: Jet) -> JetMat3 {
+        let s = (t - self.start) * (1.0 / self.duration);
+        let yaw = if s.v <= 0.0 {
+            Jet::constant(0.0)
+        } else if s.v >= 1.0 {
+            Jet::constant(self.angle)
+        } else {
+            (s - (s * TAU).sin() * (1.0 / TAU)) * self.angle
+        };
+        JetMat3::from_euler(Jet::constant(0.0), Jet::constant(0.0), yaw)
+    }
+}
+
+/// The textbook's contrast in 3D (SEEDS.md: "a platform INS leveled with a biased
+/// accelerometer gets α0 = Δf/g, which cancels the bias for all later motion"; "SINS:
+/// after a 180° turn the bias acts doubled"). Non-rotating textbook sphere (as in the
+/// single-channel text), at rest on the equator, accelerometer bias 1e-3 m/s^2 along
+/// the body's nose, everything leveled, a 180 deg turn on the spot at 10 min over 60 s.
+/// After the turn the SINS's north error follows `−2Δf/ω0² (1 − cos ω0 (t − t_c))`,
+/// which peaks at `−4Δf/ω0² = −2597 m` half a Schuler period later (checked within
+/// 0.5%: the 60 s turn rounds the step by (ω0 30 s)²/6 ~ 0.02%); the platform INS in
+/// all three azimuth mechanizations and the analytic INS stay within 1 mm (their
+/// accelerometers do not turn with the body; measured < 1e-6 m).
+#[test]
+fn leveled_platforms_ignore_the_turn_and_the_sins_doubles_the_bias() {
+    let earth = Sphere::textbook(false);
+    let turn = TurnOnSpot {
+        pos: Geodetic::new(0.0, 0.3, 0.0),
+        start: 600.0,
+        duration: 60.0,
+        angle: PI,
+    };
+    let mut cfg = config(vec![
+        SystemKind::Sins,
+        SystemKind::Platform(Azimuth::Geographic),
+        SystemKind::Platform(Azimuth::Orthodromic),
+        SystemKind::Platform(Azimuth::FreeAzimuth),
+        SystemKind::Analytic,
+    ]);
+    cfg.errors.accel_bias = Vector3::new(1e-3, 0.0, 0.0);
+    cfg.leveled = true;
+    cfg.vertical = VerticalChannel::TrueHeight;
+    cfg.step = 0.5;
+    cfg.imu_rate = 50.0;
+    cfg.output_interval = 5.0;
+    let w0 = earth.schuler_frequency();
+    let t_c = 630.0;
+    let t_peak = t_c + PI / w0;
+    let c = compare(earth, &turn, 0.0, t_peak + 100.0, &cfg).expect("runs");
+    // Before the turn the SINS is leveled too: no error.
+    let k_before = c.times.iter().position(|&t| t >= 600.0).expect("epoch");
+    assert!(c.errors[0][k_before].horizontal() < 1e-6);
+    let k = c
+        .times
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - t_peak).abs().total_cmp(&(b.1 - t_peak).abs()))
+        .expect("epochs")
+        .0;
+    let expected = -2.0 * 1e-3 / (w0 * w0) * (1.0 - (w0 * (c.times[k] - t_c)).cos());
+    let sins_north = c.errors[0][k].pos_ned.x;
+    println!("SINS north error {sins_north:.2} m, closed form {expected:.2} m");
+    assert!((sins_north / expected - 1.0).abs() < 5e-3);
+    assert!((expected + 4e-3 / (w0 * w0)).abs() < 1.0);
+    for s in 1..c.systems.len() {
+        let worst = max_of(&c, s, |e| e.horizontal());
+        println!(
+            "{:14} largest horizontal error {worst:.2e} m",
+            c.systems[s].name()
+        );
+        assert!(worst < 1e-3, "{}: {worst}", c.systems[s].name());
+    }
+}
+
+/// Zero crossings of a sampled series (linear interpolation).
+fn zero_crossings(t: &[f64], y: &[f64]) -> Vec<f64> {
+    (1..t.len())
+        .filter(|&k| y[k - 1] != 0.0 && y[k - 1].signum() != y[k].signum())
+        .map(|k| t[k - 1] + (t[k] - t[k - 1]) * y[k - 1] / (y[k - 1] - y[k]))
+        .collect()
+}
+
+/// Every system but the gyro-free one (whose errors come from its angular
+/// acceleration, not a tilt) oscillates at the Schuler period: unleveled, at rest at
+/// 30 deg on the non-rotating textbook sphere, with biases (1, 1, 0) mg-class
+/// 1e-3 m/s^2, the north and east velocity errors are `(Δf/ω0) sin ω0 t` (20) and
+/// cross zero at T0/2 and T0, T0 = 2π sqrt(a/g) = 5063.5 s (84.39 min for a = 6371
+/// km, g = 9.81). Crossings found by interpolation between 5 s epochs; the period from
+/// the first two agrees within 0.05% (2.5 s), the first crossing within 0.1%.
+#[test]
+fn horizontal_errors_oscillate_at_the_schuler_period() {
+    let earth = Sphere::textbook(false);
+    let rest = Stationary {
+        pos: Geodetic::from_degrees(30.0, 0.0, 0.0),
+        attitude: Euler::from_degrees(0.0, 0.0, 40.0),
+    };
+    let mut cfg = config(vec![
+        SystemKind::Sins,
+        SystemKind::Platform(Azimuth::Geographic),
+        SystemKind::Platform(Azimuth::Orthodromic),
+        SystemKind::Platform(Azimuth::FreeAzimuth),
+        SystemKind::Analytic,
+    ]);
+    cfg.errors.accel_bias = Vector3::new(1e-3, 1e-3, 0.0);
+    cfg.vertical = VerticalChannel::TrueHeight;
+    cfg.step = 1.0;
+    cfg.imu_rate = 20.0;
+    cfg.output_interval = 5.0;
+    let t0_schuler = TAU / earth.schuler_frequency();
+    assert!((t0_schuler - 5063.5).abs() < 0.5);
+    let c = compare(earth, &rest, 0.0, 1.15 * t0_schuler, &cfg).expect("runs");
+    for (s, kind) in c.systems.iter().enumerate() {
+        for axis in 0..2 {
+            let v: Vec<f64> = c.errors[s].iter().map(|e| e.v_ned[axis]).collect();
+            let z = zero_crossings(&c.times[1..], &v[1..]);
+            assert!(z.len() >= 2, "{} axis {axis}: {z:?}", kind.name());
+            let period = 2.0 * (z[1] - z[0]);
+            println!(
+                "{:14} axis {axis}: zeros {:.1} {:.1} s, period {period:.1} s",
+                kind.name(),
+                z[0],
+                z[1]
+            );
+            assert!((period / t0_schuler - 1.0).abs() < 5e-4);
+            assert!((z[0] / (0.5 * t0_schuler) - 1.0).abs() < 1e-3);
+        }
+    }
+}
+
+/// The platform's commanded vertical rate (22.17), NED down component, at 200 m/s east
+/// on WGS84 from 0 to 89.9 deg: the geographic platform's is
+/// `−(V tan φ/(R_N+h) + ω3 sin φ)` (to 1e-15 relative) and grows without bound (1.8e-2
+/// rad/s = 1.03 deg/s at 89.9 deg, 245 times Earth rate), the orthodromic one's is
+/// `−ω3 sin φ` (bounded by Earth rate) and the free-azimuth one's is zero; the
+/// horizontal components are the same in all three.
+#[test]
+fn geographic_platform_rate_grows_as_tan_lat_and_free_azimuth_does_not() {
+    let w = Wgs84.rotation_rate();
+    let v = 200.0;
+    for lat_deg in [0.0, 30.0, 60.0, 80.0, 89.0, 89.9] {
+        let pos = Geodetic::from_degrees(lat_deg, 20.0, 3000.0);
+        let truth = TruthPoint {
+            state: NavState::new(0.0, pos, Vector3::new(0.0, v, 0.0), Euler::default()),
+            r_e: Wgs84.geodetic_to_ecef(&pos),
+            v_e: Vector3::zeros(),
+            c_be: nalgebra::Matrix3::identity(),
+            f_e: Vector3::zeros(),
+            w_ib_b: Vector3::zeros(),
+            dw_ib_b: Vector3::zeros(),
+        };
+        let rate = |az| {
+            PlatformIns::new(
+                Wgs84,
+                az,
+                InstrumentErrors::default(),
+                VerticalChannel::Free,
+                false,
+                &truth,
+            )
+            .commanded_rate()
+        };
+        let (geo, orth, free) = (
+            rate(Azimuth::Geographic),
+            rate(Azimuth::Orthodromic),
+            rate(Azimuth::FreeAzimuth),
+        );
+        let lat = pos.lat;
+        let rn = Wgs84.radii(lat).prime_vertical + pos.h;
+        let expected = -(v * lat.tan() / rn + w * lat.sin());
+        println!(
+            "{lat_deg:5.1} deg: geographic {:.3e}, orthodromic {:.3e}, free {:.1e} rad/s",
+            geo.z, orth.z, free.z
+        );
+        assert!((geo.z - expected).abs() <= 1e-15 * expected.abs().max(w));
+        assert!((orth.z + w * lat.sin()).abs() < 1e-18);
+        assert!(free.z.abs() < 1e-18);
+        assert!((geo.xy() - free.xy()).norm() < 1e-18 && (orth.xy() - free.xy()).norm() < 1e-18);
+        if lat_deg == 89.9 {
+            assert!(geo.z.abs() > 200.0 * w && orth.z.abs() <= w);
+        }
+    }
+}
+
+/// The gyro-free INS's growth law (module `gyro_free`): biases d = 1e-9 m/s^2 on the
+/// cube's two ±y accelerometers (half-size ρ = 0.5 m) are an angular-acceleration error
+/// ε = d/(√2 ρ) = 1.414e-9 rad/s^2 about the body's x axis, here north (at rest on the
+/// equator of the non-rotating sphere). The attitude error relative to inertial space
+/// then grows as ε t²/2 and the east error as
+/// `Δr = (g ε/ω0²)(t²/2 − (1 − cos ω0 t)/ω0²)` (≈ g ε t⁴/24 early); the reported tilt,
+/// relative to the level at the computed position, is `ε t²/2 − Δr/a`. Both checked
+/// to 1e-5 relative at 10, 20, 30 and 40 min (measured 1e-7; ε t² ≤ 8e-3 rad keeps
+/// the motion linear).
+#[test]
+fn gyro_free_error_growth_law() {
+    let earth = Sphere::textbook(false);
+    let rest = Stationary {
+        pos: Geodetic::new(0.0, 0.0, 0.0),
+        attitude: Euler::default(),
+    };
+    let rho = 0.5;
+    let d = 1e-9;
+    let mut cfg = config(vec![SystemKind::GyroFree]);
+    cfg.gyro_free_array = AccelerometerArray::cube(rho).expect("regular");
+    cfg.gyro_free_biases = Vector6::new(0.0, 0.0, d, d, 0.0, 0.0);
+    cfg.vertical = VerticalChannel::TrueHeight;
+    cfg.step = 0.5;
+    cfg.output_interval = 60.0;
+    let c = compare(earth, &rest, 0.0, 2400.0, &cfg).expect("runs");
+    let eps = d / (2f64.sqrt() * rho);
+    let w0 = earth.schuler_frequency();
+    let g = earth.gravitation(earth.radius);
+    for minutes in [10usize, 20, 30, 40] {
+        let e = &c.errors[0][minutes];
+        let t = c.times[minutes];
+        let east = g * eps / (w0 * w0) * (t * t / 2.0 - (1.0 - (w0 * t).cos()) / (w0 * w0));
+        let tilt = eps * t * t / 2.0 - east / earth.radius;
+        println!(
+            "{minutes} min: tilt {:.4e} (law {tilt:.4e}) rad, east {:.4} (law {east:.4}) m, early law {:.4} m",
+            e.attitude.x,
+            e.pos_ned.y,
+            g * eps * t.powi(4) / 24.0
+        );
+        assert!((e.attitude.x / tilt - 1.0).abs() < 1e-5);
+        assert!((e.pos_ned.y / east - 1.0).abs() < 1e-5);
+    }
+}
+
+/// The triad-and-offsets array (the lecture's layout made regular) computes ω̇ with
+/// the computed ω in its centripetal terms, and the rate error then grows like
+/// exp(|ω| t): on the maneuvering flight with perfect instruments it drifts from
+/// round-off to over 1e-6 rad in 20 min, while the cube, whose ω̇ needs no ω, stays
+/// at round-off (< 1e-10 rad).
+#[test]
+fn triad_and_offsets_diverges_under_rotation() {
+    let traj = Maneuvering::flight(Geodetic::from_degrees(45.0, 10.0, 1000.0));
+    let mut cfg = config(vec![SystemKind::GyroFree]);
+    cfg.output_interval = 60.0;
+    let cube = compare(Wgs84, &traj, 0.0, 1200.0, &cfg).expect("runs");
+    cfg.gyro_free_array = AccelerometerArray::triad_and_offsets(0.5).expect("regular");
+    let triad = compare(Wgs84, &traj, 0.0, 1200.0, &cfg).expect("runs");
+    let (a_cube, a_triad) = (
+        max_of(&cube, 0, |e| e.attitude.norm()),
+        max_of(&triad, 0, |e| e.attitude.norm()),
+    );
+    println!("attitude error: cube {a_cube:.2e} rad, triad and offsets {a_triad:.2e} rad");
+    assert!(a_cube < 1e-10 && a_triad > 1e-6);
+}
