@@ -4,5 +4,6 @@
 pub mod channel;
 pub mod demo;
 pub mod nav;
+pub mod platform;
 pub mod simulate;
 pub mod vertical;
