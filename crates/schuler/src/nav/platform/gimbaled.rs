@@ -111,8 +111,9 @@ fn rz(a: f64) -> Matrix3<f64> {
 }
 
 impl<E: EarthModel> PlatformIns<E> {
-    /// A platform INS starting at the truth `start` with its frame along NED (α = 0);
-    /// when `leveled`, the platform is tilted so the biased accelerometers read the
+    /// A platform INS starting at the truth `start`, its x axis north (α = 0), except
+    /// the orthodromic platform's, which starts along the initial track (the great
+    /// circle being flown, when the ground speed exceeds 0.1 m/s); when `leveled`, the platform is tilted so the biased accelerometers read the
     /// true horizontal specific force ([`leveling`]), otherwise it is exactly level.
     pub fn new(
         earth: E,
@@ -123,7 +124,11 @@ impl<E: EarthModel> PlatformIns<E> {
         start: &TruthPoint,
     ) -> Self {
         let s = &start.state;
-        let c_ce = c_ne(s.pos.lat, s.pos.lon);
+        let alpha0 = match azimuth {
+            Azimuth::Orthodromic if s.v_n.x.hypot(s.v_n.y) > 0.1 => s.v_n.y.atan2(s.v_n.x),
+            _ => 0.0,
+        };
+        let c_ce = c_ne(s.pos.lat, s.pos.lon) * rz(alpha0);
         let c_pc = if leveled {
             let f_c = c_ce.transpose() * start.f_e;
             leveling(&f_c, &errors.accel_bias, &Vector3::z_axis()).into_inner()
@@ -143,7 +148,7 @@ impl<E: EarthModel> PlatformIns<E> {
                 q_pi: q(c_ce * c_pc),
                 q_ce: q(c_ce),
                 h: s.pos.h,
-                v_c: s.v_n,
+                v_c: rz(alpha0).transpose() * s.v_n,
             },
         }
     }
