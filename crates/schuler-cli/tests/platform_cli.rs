@@ -131,6 +131,32 @@ fn example_config_runs() {
         .stdout(predicate::str::contains("| gyro-free |"));
 }
 
+/// The simulator's IMU model: a navigation-grade `[imu]` with a seed runs, is
+/// recorded in the summary, and conflicts with a second SINS rate.
+#[test]
+fn imu_model_from_a_scenario_table() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let with_imu = REST.replace("imu_rate_hz = 20\n", "seed = 3\n")
+        + "[imu]\nrate_hz = 20\npreset = \"navigation\"\n";
+    let cfg = write(dir.path(), "imu.toml", &with_imu);
+    let out = dir.path().join("run");
+    run(&cfg, &out).success();
+    let s: Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("summary.json")).expect("summary.json"),
+    )
+    .expect("JSON");
+    assert_eq!(s["inputs"]["imu_model"], true);
+    assert_eq!(s["inputs"]["seed"], 3);
+    let both = write(
+        dir.path(),
+        "both.toml",
+        &(REST.to_owned() + "[imu]\nrate_hz = 20\n"),
+    );
+    run(&both, &dir.path().join("both"))
+        .failure()
+        .stderr(predicate::str::contains("imu_rate_hz"));
+}
+
 /// Bad configs fail with the key and the reason, never a panic.
 #[test]
 fn config_errors_name_the_key() {

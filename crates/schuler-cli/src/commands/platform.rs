@@ -4,7 +4,9 @@
 //! the gyro-free six-accelerometer INS ([`schuler::nav::platform`]).
 //!
 //! The config is a scenario's `[start]` and `[[motion]]` (as for `schuler simulate`)
-//! plus the run's settings, `[errors]` and `[gyro_free]`; see `examples/platform.toml`.
+//! plus the run's settings, `[errors]`, `[gyro_free]` and optionally a scenario's
+//! `[imu]` (the simulator's error model, applied with `seed` to the SINS's, the
+//! platforms' and the analytic INS's instruments alike); see `examples/platform.toml`.
 //! Writes `errors.csv` (`t` and, per system, `SYS_north,SYS_east,SYS_down` [m],
 //! `SYS_vn,SYS_ve,SYS_vd` [m/s], `SYS_att_n,SYS_att_e,SYS_att_d` [rad]), one plot per
 //! error quantity with every system (`north.svg`, `east.svg`, `horizontal.svg`,
@@ -20,6 +22,7 @@ use schuler::nav::platform::compare::{CompareConfig, Comparison, NavError, Syste
 use schuler::nav::platform::{AccelerometerArray, InstrumentErrors, VerticalChannel};
 use schuler::sim::run::EarthSpec;
 use schuler::sim::scenario::{MotionSpec, Quantity, SegmentSpec, StartSpec};
+use schuler::sim::sensor_spec::ImuSpec;
 use schuler::units::{ARCSEC, Dimension};
 use serde::Deserialize;
 use serde_json::json;
@@ -100,6 +103,10 @@ struct ConfigSpec {
     errors: ErrorsSpec,
     #[serde(default)]
     gyro_free: GyroFreeSpec,
+    /// The simulator's IMU model (as in a scenario) on top of `[errors]`.
+    imu: Option<ImuSpec>,
+    #[serde(default)]
+    seed: u64,
 }
 
 fn yes() -> bool {
@@ -164,7 +171,13 @@ fn parse(spec: ConfigSpec) -> Result<Config> {
         Some(q) => positive(si(q, "step", Dimension::Time)?, "step")?,
         None => 0.1,
     };
-    let imu_rate = positive(spec.imu_rate_hz.unwrap_or(100.0), "imu_rate_hz")?;
+    let (imu_rate, sensor_model) = match (&spec.imu, spec.imu_rate_hz) {
+        (Some(_), Some(_)) => {
+            bail!("imu_rate_hz: give the SINS rate once, as imu.rate_hz when [imu] is present")
+        }
+        (Some(imu), None) => (imu.rate_hz, Some(imu.model()?)),
+        (None, rate) => (positive(rate.unwrap_or(100.0), "imu_rate_hz")?, None),
+    };
     let output_interval = match &spec.output_interval {
         Some(q) => positive(
             si(q, "output_interval", Dimension::Time)?,
@@ -231,6 +244,8 @@ fn parse(spec: ConfigSpec) -> Result<Config> {
         },
         compare: CompareConfig {
             errors,
+            sensor_model,
+            seed: spec.seed,
             gyro_free_array: array,
             gyro_free_biases,
             leveled: spec.leveled,
@@ -541,6 +556,8 @@ fn summary(cfg: &Config, c: &Comparison, k: usize) -> serde_json::Value {
             "earth": format!("{:?}", cfg.earth),
             "accel_bias_m_s2": v3(&cc.errors.accel_bias),
             "gyro_drift_rad_s": v3(&cc.errors.gyro_drift),
+            "imu_model": cc.sensor_model.is_some(),
+            "seed": cc.seed,
             "gyro_free_accel_bias_m_s2": cc.gyro_free_biases.iter().collect::<Vec<_>>(),
             "gyro_free_positions_m": cc.gyro_free_array.positions.iter().map(v3).collect::<Vec<_>>(),
             "gyro_free_axes": cc.gyro_free_array.axes.iter().map(|u| v3(&u.into_inner())).collect::<Vec<_>>(),

@@ -12,10 +12,9 @@
 //! body attitude is `C_bi = C_pb`.
 
 use super::inertial::{aid_vertical, gravitation_i, inertial_from_truth, nav_state};
+use super::sensors::Sensors;
 use super::truth::{TruthPoint, c_ei};
-use super::{
-    InstrumentErrors, OdeState, TruthDriven, VerticalChannel, leveling, quat_rate, rk4, unit,
-};
+use super::{OdeState, TruthDriven, VerticalChannel, leveling, quat_rate, rk4, unit};
 use crate::earth::{EarthModel, c_ne};
 use crate::nav::NavState;
 use nalgebra::{Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
@@ -39,10 +38,10 @@ impl OdeState for State {
 }
 
 /// The analytic INS over an Earth model.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct AnalyticIns<E: EarthModel> {
     earth: E,
-    errors: InstrumentErrors,
+    sensors: Sensors,
     vertical: VerticalChannel,
     t0: f64,
     x: State,
@@ -53,11 +52,12 @@ impl<E: EarthModel> AnalyticIns<E> {
     /// axes (tilted by the leveling when `leveled`, see [`leveling`]).
     pub fn new(
         earth: E,
-        errors: InstrumentErrors,
+        sensors: impl Into<Sensors>,
         vertical: VerticalChannel,
         leveled: bool,
         start: &TruthPoint,
     ) -> Self {
+        let sensors = sensors.into();
         let t0 = start.state.t;
         let (r_i, v_i) = inertial_from_truth(&earth, t0, start);
         let c_pi = if leveled {
@@ -65,27 +65,43 @@ impl<E: EarthModel> AnalyticIns<E> {
             let down = c_ne(start.state.pos.lat, start.state.pos.lon)
                 .column(2)
                 .into_owned();
-            leveling(&start.f_e, &errors.accel_bias, &Unit::new_normalize(down))
+            leveling(
+                &start.f_e,
+                &sensors.initial_accel_bias(),
+                &Unit::new_normalize(down),
+            )
         } else {
             Rotation3::identity()
         };
         let q_pi = UnitQuaternion::from_rotation_matrix(&c_pi).into_inner();
         Self {
             earth,
-            errors,
+            sensors,
             vertical,
             t0,
             x: State { q_pi, r_i, v_i },
         }
     }
 
-    fn derivative(&self, x: &State, truth: &TruthPoint) -> State {
-        let t = truth.state.t;
+    /// True specific force in the platform's axes.
+    fn specific_force(&self, x: &State, truth: &TruthPoint) -> Vector3<f64> {
         let c_pi = unit(&x.q_pi).to_rotation_matrix().into_inner();
-        let n_i = c_ei(self.earth.rotation_rate(), t, self.t0) * truth.f_e;
-        let f_p = c_pi.transpose() * n_i + self.errors.accel_bias;
+        c_pi.transpose() * (c_ei(self.earth.rotation_rate(), truth.state.t, self.t0) * truth.f_e)
+    }
+
+    /// The derivative with gyro error `e_w` (platform drift) and accelerometer error
+    /// `e_f`.
+    fn derivative(
+        &self,
+        x: &State,
+        truth: &TruthPoint,
+        e_w: &Vector3<f64>,
+        e_f: &Vector3<f64>,
+    ) -> State {
+        let t = truth.state.t;
+        let f_p = self.specific_force(x, truth) + e_f;
         State {
-            q_pi: quat_rate(&x.q_pi, &self.errors.gyro_drift),
+            q_pi: quat_rate(&x.q_pi, e_w),
             r_i: x.v_i,
             v_i: f_p + gravitation_i(&self.earth, t, self.t0, &x.r_i),
         }
@@ -96,7 +112,14 @@ impl<E: EarthModel> TruthDriven for AnalyticIns<E> {
     fn step(&mut self, a: &TruthPoint, m: &TruthPoint, c: &TruthPoint) {
         let dt = c.state.t - a.state.t;
         let nodes = [a, m, c];
-        let mut x = rk4(&self.x, dt, |k, x| self.derivative(x, nodes[k]));
+        // The gyros hold the platform still: their input is (ideally) zero.
+        let (e_w, e_f) = self.sensors.step(
+            c.state.t,
+            dt,
+            &Vector3::zeros(),
+            &self.specific_force(&self.x, a),
+        );
+        let mut x = rk4(&self.x, dt, |k, x| self.derivative(x, nodes[k], &e_w, &e_f));
         x.q_pi = unit(&x.q_pi).into_inner();
         if self.vertical == VerticalChannel::TrueHeight {
             (x.r_i, x.v_i) = aid_vertical(&self.earth, self.t0, c, &x.r_i, &x.v_i);

@@ -3,20 +3,23 @@
 //! three azimuth mechanizations, the analytic INS and the gyro-free INS, with their
 //! navigation errors against the truth at common epochs.
 //!
-//! The same [`InstrumentErrors`] act in each system's own sensor axes: body for the
-//! SINS, the platform for the platform and analytic systems. The gyro-free INS has no
-//! gyros; its six accelerometers carry their own biases (see [`CompareConfig`]).
+//! The same [`InstrumentErrors`], and optionally the same simulator IMU model with the
+//! same seed (so the same turn-on biases and noise sequence), act in each system's own
+//! sensor axes: body for the SINS, the platform for the platform and analytic systems.
+//! The gyro-free INS has no gyros; its six accelerometers carry their own constant
+//! biases (see [`CompareConfig`]).
 
 use super::gyro_free::AccelerometerArray;
 use super::truth::{TruthPoint, truth_at};
 use super::{
-    AnalyticIns, Azimuth, GyroFreeIns, InstrumentErrors, PlatformIns, TruthDriven, VerticalChannel,
-    level_rotation,
+    AnalyticIns, Azimuth, GyroFreeIns, InstrumentErrors, PlatformIns, Sensors, TruthDriven,
+    VerticalChannel, level_rotation,
 };
 use crate::earth::{EarthModel, Geodetic};
 use crate::nav::{LocalLevel, Mechanization, NavState};
 use crate::rotation::rotation_vector_from_quaternion;
 use crate::sim::analytic::{self, Trajectory};
+use crate::sim::imu_model::{ImuModel, ImuSimulator};
 use nalgebra::{UnitQuaternion, Vector3, Vector6};
 use std::f64::consts::{PI, TAU};
 
@@ -60,6 +63,11 @@ impl SystemKind {
 pub struct CompareConfig {
     /// Biases and drifts of the SINS, platform and analytic instruments.
     pub errors: InstrumentErrors,
+    /// The simulator's IMU error model on top of `errors` for the same instruments
+    /// (none: constant errors only).
+    pub sensor_model: Option<ImuModel>,
+    /// Seed of the model's random draws.
+    pub seed: u64,
     /// The gyro-free INS's accelerometers.
     pub gyro_free_array: AccelerometerArray,
     /// Their biases [m/s^2], in the array's order.
@@ -229,18 +237,22 @@ fn run_truth_driven<E: EarthModel, T: Trajectory + ?Sized>(
     cfg: &CompareConfig,
 ) -> Vec<NavError> {
     let start = truth_at(earth, traj, times[0]);
+    let sensors = || match &cfg.sensor_model {
+        Some(m) => Sensors::with_model(cfg.errors, m.clone(), cfg.seed),
+        None => Sensors::constant(cfg.errors),
+    };
     let mut sys: Box<dyn TruthDriven> = match kind {
         SystemKind::Platform(az) => Box::new(PlatformIns::new(
             *earth,
             az,
-            cfg.errors,
+            sensors(),
             cfg.vertical,
             cfg.leveled,
             &start,
         )),
         SystemKind::Analytic => Box::new(AnalyticIns::new(
             *earth,
-            cfg.errors,
+            sensors(),
             cfg.vertical,
             cfg.leveled,
             &start,
@@ -283,15 +295,20 @@ fn run_sins<E: EarthModel, T: Trajectory + ?Sized>(
     cfg: &CompareConfig,
 ) -> Vec<NavError> {
     let start = truth_at(earth, traj, times[0]);
+    let mut model = cfg
+        .sensor_model
+        .as_ref()
+        .map(|m| ImuSimulator::new(m.clone(), cfg.seed));
     let mut initial = start.state;
     if cfg.leveled {
         let c_bn = start.state.q_bn.to_rotation_matrix();
         let f_n = c_bn * start.f_b();
-        let r = level_rotation(
-            &(f_n + c_bn * cfg.errors.accel_bias),
-            &f_n,
-            &Vector3::z_axis(),
-        );
+        let bias = cfg.errors.accel_bias
+            + match (&model, &cfg.sensor_model) {
+                (Some(sim), Some(m)) => m.accel.bias + sim.turn_on_biases().1,
+                _ => Vector3::zeros(),
+            };
+        let r = level_rotation(&(f_n + c_bn * bias), &f_n, &Vector3::z_axis());
         initial.q_bn = UnitQuaternion::from_rotation_matrix(&r) * initial.q_bn;
     }
     let mut sins = LocalLevel::new(*earth, initial);
@@ -308,6 +325,9 @@ fn run_sins<E: EarthModel, T: Trajectory + ?Sized>(
             };
             let (mut s, tr, end) = analytic::increment_from(earth, traj, t, dt, &prev);
             prev = end;
+            if let Some(sim) = &mut model {
+                s = sim.measure(&s);
+            }
             s.dtheta += cfg.errors.gyro_drift * dt;
             s.dvel += cfg.errors.accel_bias * dt;
             sins.step(&s);

@@ -21,10 +21,9 @@
 //! `dh/dt = −v_z`. The gimbal angles measure the true body attitude relative to the
 //! platform, so the computed `C_bn = R_z(α) C_pb`.
 
+use super::sensors::Sensors;
 use super::truth::{TruthPoint, c_ei};
-use super::{
-    InstrumentErrors, OdeState, TruthDriven, VerticalChannel, leveling, quat_rate, rk4, unit,
-};
+use super::{OdeState, TruthDriven, VerticalChannel, leveling, quat_rate, rk4, unit};
 use crate::earth::{EarthModel, c_ne};
 use crate::nav::NavState;
 use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
@@ -86,11 +85,11 @@ impl OdeState for State {
 }
 
 /// A platform INS in one azimuth mechanization over an Earth model.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct PlatformIns<E: EarthModel> {
     earth: E,
     azimuth: Azimuth,
-    errors: InstrumentErrors,
+    sensors: Sensors,
     vertical: VerticalChannel,
     t0: f64,
     x: State,
@@ -118,11 +117,12 @@ impl<E: EarthModel> PlatformIns<E> {
     pub fn new(
         earth: E,
         azimuth: Azimuth,
-        errors: InstrumentErrors,
+        sensors: impl Into<Sensors>,
         vertical: VerticalChannel,
         leveled: bool,
         start: &TruthPoint,
     ) -> Self {
+        let sensors = sensors.into();
         let s = &start.state;
         let alpha0 = match azimuth {
             Azimuth::Orthodromic if s.v_n.x.hypot(s.v_n.y) > 0.1 => s.v_n.y.atan2(s.v_n.x),
@@ -131,7 +131,7 @@ impl<E: EarthModel> PlatformIns<E> {
         let c_ce = c_ne(s.pos.lat, s.pos.lon) * rz(alpha0);
         let c_pc = if leveled {
             let f_c = c_ce.transpose() * start.f_e;
-            leveling(&f_c, &errors.accel_bias, &Vector3::z_axis()).into_inner()
+            leveling(&f_c, &sensors.initial_accel_bias(), &Vector3::z_axis()).into_inner()
         } else {
             Matrix3::identity()
         };
@@ -141,7 +141,7 @@ impl<E: EarthModel> PlatformIns<E> {
         Self {
             earth,
             azimuth,
-            errors,
+            sensors,
             vertical,
             t0: s.t,
             x: State {
@@ -183,14 +183,27 @@ impl<E: EarthModel> PlatformIns<E> {
         }
     }
 
-    fn derivative(&self, x: &State, truth: &TruthPoint) -> State {
-        let fr = self.frame(x);
-        let w_ic_c = fr.w_ie_c + fr.w_ec_c;
+    /// True specific force in the platform's axes.
+    fn specific_force(&self, x: &State, truth: &TruthPoint) -> Vector3<f64> {
         let c_pi = unit(&x.q_pi).to_rotation_matrix().into_inner();
         let c_ei = c_ei(self.earth.rotation_rate(), truth.state.t, self.t0);
-        let f_p = c_pi.transpose() * (c_ei * truth.f_e) + self.errors.accel_bias;
+        c_pi.transpose() * (c_ei * truth.f_e)
+    }
+
+    /// The derivative with gyro error `e_w` (platform drift) and accelerometer error
+    /// `e_f`.
+    fn derivative(
+        &self,
+        x: &State,
+        truth: &TruthPoint,
+        e_w: &Vector3<f64>,
+        e_f: &Vector3<f64>,
+    ) -> State {
+        let fr = self.frame(x);
+        let w_ic_c = fr.w_ie_c + fr.w_ec_c;
+        let f_p = self.specific_force(x, truth) + e_f;
         State {
-            q_pi: quat_rate(&x.q_pi, &(w_ic_c + self.errors.gyro_drift)),
+            q_pi: quat_rate(&x.q_pi, &(w_ic_c + e_w)),
             q_ce: quat_rate(&x.q_ce, &fr.w_ec_c),
             h: -x.v_c.z,
             v_c: f_p + fr.g_c - (2.0 * fr.w_ie_c + fr.w_ec_c).cross(&x.v_c),
@@ -214,7 +227,14 @@ impl<E: EarthModel> TruthDriven for PlatformIns<E> {
     fn step(&mut self, a: &TruthPoint, m: &TruthPoint, c: &TruthPoint) {
         let dt = c.state.t - a.state.t;
         let nodes = [a, m, c];
-        let mut x = rk4(&self.x, dt, |k, x| self.derivative(x, nodes[k]));
+        let fr = self.frame(&self.x);
+        let (e_w, e_f) = self.sensors.step(
+            c.state.t,
+            dt,
+            &(fr.w_ie_c + fr.w_ec_c),
+            &self.specific_force(&self.x, a),
+        );
+        let mut x = rk4(&self.x, dt, |k, x| self.derivative(x, nodes[k], &e_w, &e_f));
         x.q_pi = unit(&x.q_pi).into_inner();
         x.q_ce = unit(&x.q_ce).into_inner();
         if self.vertical == VerticalChannel::TrueHeight {

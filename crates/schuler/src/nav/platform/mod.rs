@@ -22,7 +22,8 @@
 //! platform's true attitude driven by the commanded rate plus gyro drift, the computer's
 //! navigation equations driven by what the accelerometers read), integrated by RK4 with
 //! the truth evaluated at each step's start, middle and end ([`truth`]). Instrument
-//! errors are constant biases and drifts ([`InstrumentErrors`]); the initial leveling
+//! errors are constant biases and drifts ([`InstrumentErrors`]), optionally with the
+//! simulator's full IMU error model ([`sensors`]); the initial leveling
 //! ([`leveling`]) tilts the sensors so that the biased accelerometers read the true
 //! horizontal specific force, as a real leveling does. [`compare`] runs every system
 //! on one trajectory.
@@ -32,12 +33,14 @@ pub mod compare;
 pub mod gimbaled;
 pub mod gyro_free;
 pub mod inertial;
+pub mod sensors;
 pub mod truth;
 
 pub use analytic::AnalyticIns;
 pub use compare::{CompareConfig, Comparison, NavError, SystemKind, compare};
 pub use gimbaled::{Azimuth, PlatformIns};
 pub use gyro_free::{AccelerometerArray, GyroFreeError, GyroFreeIns};
+pub use sensors::Sensors;
 pub use truth::{TruthPoint, truth_at};
 
 use nalgebra::{Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
