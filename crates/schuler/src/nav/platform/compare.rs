@@ -155,13 +155,13 @@ pub struct Comparison {
     pub errors: Vec<Vec<NavError>>,
 }
 
-/// A positive whole ratio `a / b`, or an error naming `key`.
-fn whole(a: f64, b: f64, key: &'static str) -> Result<usize, CompareError> {
+/// A positive whole ratio `a / b`, or an error naming `key` with `what` the ratio is.
+fn whole(a: f64, b: f64, key: &'static str, what: &str) -> Result<usize, CompareError> {
     let n = (a / b).round();
     if !(n >= 1.0 && ((a / b) - n).abs() < 1e-6) {
         return Err(CompareError::Setting {
             key,
-            message: format!("{a} s is not a whole number of {b} s steps"),
+            message: format!("{what} = {} must be a whole number", a / b),
         });
     }
     Ok(n as usize)
@@ -190,8 +190,18 @@ pub fn compare<E: EarthModel, T: Trajectory + Sync + ?Sized>(
     positive(cfg.imu_rate, "imu_rate_hz")?;
     positive(cfg.output_interval, "output_interval")?;
     positive(t1 - t0, "duration")?;
-    let steps = whole(cfg.output_interval, cfg.step, "step")?;
-    let samples = whole(cfg.output_interval * cfg.imu_rate, 1.0, "imu_rate_hz")?;
+    let steps = whole(
+        cfg.output_interval,
+        cfg.step,
+        "step",
+        "output_interval / step",
+    )?;
+    let samples = whole(
+        cfg.output_interval * cfg.imu_rate,
+        1.0,
+        "imu_rate_hz",
+        "output_interval × imu_rate_hz",
+    )?;
     let epochs = ((t1 - t0) / cfg.output_interval + 1e-9).floor() as usize;
     let times: Vec<f64> = (0..=epochs)
         .map(|k| t0 + k as f64 * cfg.output_interval)
