@@ -419,9 +419,9 @@ fn write_errors_csv(path: &Path, c: &Comparison) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Writes one plot per quantity. A system whose error leaves the others' scale by
-/// more than 3 times (the gyro-free INS, usually) is drawn until then and labelled
-/// with the time it goes off scale, so the others stay readable.
+/// Writes one plot per quantity. One system whose error peaks more than 20 times
+/// above every other's (the gyro-free INS, usually) is drawn only until it passes 1.5
+/// times the next peak, and labelled with that time, so the others keep the scale.
 fn write_plots(dir: &Path, c: &Comparison) -> Result<()> {
     let (tscale, tlabel) = super::channel::time_axis(c.times[c.times.len() - 1] - c.times[0]);
     let t: Vec<f64> = c.times.iter().map(|x| (x - c.times[0]) / tscale).collect();
@@ -436,9 +436,13 @@ fn write_plots(dir: &Path, c: &Comparison) -> Result<()> {
         let peaks: Vec<f64> = values.iter().map(peak).collect();
         let mut sorted = peaks.clone();
         sorted.sort_by(f64::total_cmp);
-        // The scale: 3 times the second-largest peak (the largest may be the outlier).
-        let limit = if sorted.len() >= 2 {
-            3.0 * sorted[sorted.len() - 2]
+        let n = sorted.len();
+        // The largest sorts last, NaN after everything (total order): an outlier too.
+        let outlier = n >= 2
+            && sorted[n - 2] > 0.0
+            && (sorted[n - 1].is_nan() || sorted[n - 1] > 20.0 * sorted[n - 2]);
+        let limit = if outlier {
+            1.5 * sorted[n - 2]
         } else {
             f64::INFINITY
         };
@@ -446,9 +450,9 @@ fn write_plots(dir: &Path, c: &Comparison) -> Result<()> {
         for (s, v) in values.iter().enumerate() {
             let name = c.systems[s].name();
             // Beyond the limit, or not finite.
-            let off = v.iter().position(|x| {
-                limit > 0.0 && x.abs().partial_cmp(&limit) != Some(std::cmp::Ordering::Less)
-            });
+            let off = v
+                .iter()
+                .position(|x| x.abs().partial_cmp(&limit) != Some(std::cmp::Ordering::Less));
             let label = match off {
                 Some(k) => format!(
                     "{name} (off scale after {:.3} {})",
