@@ -27,6 +27,9 @@ enum Command {
     Channel(schuler_cli::commands::channel::Args),
     /// The vertical channel: free, baro-aided, with faults and prediction.
     Vertical(schuler_cli::commands::vertical::Args),
+    /// Lecture 22's systems on one trajectory: SINS, platform INS (geographic,
+    /// orthodromic, free-azimuth), analytic INS and gyro-free INS, errors compared.
+    Platform(schuler_cli::commands::platform::Args),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +41,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => schuler_cli::commands::simulate::run(args),
         Command::Channel(args) => schuler_cli::commands::channel::run(args),
         Command::Vertical(args) => schuler_cli::commands::vertical::run(args),
+        Command::Platform(args) => schuler_cli::commands::platform::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

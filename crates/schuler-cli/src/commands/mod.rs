@@ -6,5 +6,6 @@ pub mod align;
 pub mod channel;
 pub mod demo;
 pub mod nav;
+pub mod platform;
 pub mod simulate;
 pub mod vertical;

@@ -14,6 +14,7 @@
 
 pub mod frame;
 pub mod local_level;
+pub mod platform;
 pub mod state;
 pub mod strapdown;
 pub mod wander;
