@@ -198,11 +198,17 @@ struct Epoch {
 
 struct Run {
     epochs: Vec<Epoch>,
+    /// Horizontal error of the smoothed trajectory at each second (with `smooth`).
+    smoothed: Vec<(f64, f64)>,
     rejected: usize,
     rejected_outliers: usize,
 }
 
 fn run(seed: u64, gnss: &[GnssFix], outlier_times: &[f64]) -> Run {
+    run_with(seed, gnss, outlier_times, false)
+}
+
+fn run_with(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool) -> Run {
     let d = data();
     let model = tactical();
     let noise = ImuNoise::from_model(&model);
@@ -219,12 +225,16 @@ fn run(seed: u64, gnss: &[GnssFix], outlier_times: &[f64]) -> Run {
     let mut imu = ImuSimulator::new(model, seed);
     let start = d.truth[0];
     let mut integ = Integrator::new(LocalLevel::new(Wgs84, start), Wgs84, cfg);
+    if smooth {
+        integ = integ.with_smoother();
+    }
     integ.prime(&imu.measure(&d.exact[0]));
     let mut fixes = gnss.iter().copied().peekable();
     let mut epochs = Vec::new();
     for (s, truth) in d.exact.iter().zip(&d.truth).skip(1) {
         integ.step_with_fixes(&imu.measure(s), &mut fixes);
         if (truth.t - truth.t.round()).abs() < 1e-6 {
+            integ.record_output();
             let est = integ.state();
             let c_en = schuler::earth::c_ne(truth.pos.lat, truth.pos.lon).transpose();
             let dr = c_en * (Wgs84.geodetic_to_ecef(&est.pos) - Wgs84.geodetic_to_ecef(&truth.pos));
@@ -248,8 +258,22 @@ fn run(seed: u64, gnss: &[GnssFix], outlier_times: &[f64]) -> Run {
             hit
         })
         .count();
+    let truth_at =
+        |t: f64| d.truth[((t - d.truth[0].t) / (d.truth[1].t - d.truth[0].t)).round() as usize];
+    let smoothed = integ
+        .smoothed()
+        .iter()
+        .map(|s| {
+            let truth = truth_at(s.state.t);
+            let c_en = schuler::earth::c_ne(truth.pos.lat, truth.pos.lon).transpose();
+            let dr =
+                c_en * (Wgs84.geodetic_to_ecef(&s.state.pos) - Wgs84.geodetic_to_ecef(&truth.pos));
+            (s.state.t, dr.x.hypot(dr.y))
+        })
+        .collect();
     Run {
         epochs,
+        smoothed,
         rejected: integ.rejected.len(),
         rejected_outliers,
     }
@@ -358,4 +382,35 @@ fn injected_outliers_are_all_rejected() {
         a.rejected
     );
     assert!((rms(&b) / rms(&a) - 1.0).abs() < 0.1);
+}
+
+#[test]
+fn the_smoother_at_least_halves_the_error_in_outages() {
+    let (gnss, _) = fixes(31, &[]);
+    let r = run_with(32, &gnss, &[], true);
+    assert_eq!(r.smoothed.len(), r.epochs.len());
+    for (k, &(a, b)) in OUTAGES.iter().enumerate() {
+        let fwd = r
+            .epochs
+            .iter()
+            .filter(|e| e.t >= a && e.t <= b)
+            .map(horizontal)
+            .fold(0.0, f64::max);
+        let smo = r
+            .smoothed
+            .iter()
+            .filter(|e| e.0 >= a && e.0 <= b)
+            .map(|e| e.1)
+            .fold(0.0, f64::max);
+        println!("outage {k}: forward max {fwd:.3} m, smoothed max {smo:.3} m");
+        assert!(smo <= 0.5 * fwd, "outage {k}: {smo} vs {fwd}");
+    }
+    // Outside the outages the smoother is no worse than the filter's RTK level.
+    let worst = r
+        .smoothed
+        .iter()
+        .filter(|e| e.0 > 120.0 && !in_outage(e.0))
+        .map(|e| e.1)
+        .fold(0.0, f64::max);
+    assert!(worst < 0.15, "{worst}");
 }

@@ -29,6 +29,8 @@ pub struct Aiding {
     pub fixes: Vec<GnssFix>,
     /// The filter's settings.
     pub config: IntegrationConfig,
+    /// Write the smoothed trajectory too.
+    pub smooth: bool,
 }
 
 /// What an aided run did, beyond [`NavSummary`].
@@ -119,6 +121,38 @@ fn write_epoch<E: EarthModel>(
     err.row(state.t, &row)
 }
 
+/// The smoothed trajectory: `nav.txt`, `nav.csv`, `std.txt`, `imu_err.txt` in `dir`.
+fn write_smoothed<E: EarthModel>(
+    earth: &E,
+    dir: &Path,
+    week: u32,
+    integ: &Integrator<LocalLevel<E>, E>,
+) -> Result<()> {
+    let mut nav = NavWriter::create_extended(dir, week, earth)?;
+    let mut std = Table::create(dir, "std.txt")?;
+    let mut err = Table::create(dir, "imu_err.txt")?;
+    for s in integ.smoothed() {
+        nav.write_epoch(&NavEpoch {
+            state: s.state,
+            r_e: earth.geodetic_to_ecef(&s.state.pos),
+            wander_azimuth: 0.0,
+        })?;
+        let mut row: Vec<f64> = s.std[0].iter().chain(s.std[1].iter()).copied().collect();
+        row.extend(s.std[2].iter().map(|x| x.to_degrees()));
+        std.row(s.state.t, &row)?;
+        let e = s.estimates;
+        let mut row = Vec::with_capacity(12);
+        row.extend(e.gyro_bias.iter().map(|x| x * DPH));
+        row.extend(e.accel_bias.iter().map(|x| x * MGAL));
+        row.extend(e.gyro_scale.iter().map(|x| x * PPM));
+        row.extend(e.accel_scale.iter().map(|x| x * PPM));
+        err.row(s.state.t, &row)?;
+    }
+    nav.finish()?;
+    std.finish()?;
+    err.finish()
+}
+
 fn write_rejections<E: EarthModel>(dir: &Path, integ: &Integrator<LocalLevel<E>, E>) -> Result<()> {
     let path = dir.join("rejected.csv");
     let mut s = String::from("t,measurement,reason,nis,threshold\n");
@@ -177,12 +211,16 @@ where
         settings.init_att,
     );
     let mut integ = Integrator::new(LocalLevel::new(earth, init), earth, aiding.config);
+    if aiding.smooth {
+        integ = integ.with_smoother();
+    }
     integ.prime(&first);
     let mut std = Table::create(&settings.out, "std.txt")?;
     let mut err = Table::create(&settings.out, "imu_err.txt")?;
     let mut fixes = aiding.fixes.iter().copied().peekable();
     let mut decimator = Decimator::new(settings.output_rate);
     decimator.take(first.t, first.dt);
+    integ.record_output();
     write_epoch(&integ, &earth, &mut writer, &mut std, &mut err)?;
     let mut n = 0u64;
     let mut last_t = first.t;
@@ -199,6 +237,7 @@ where
         n += 1;
         last_t = s.t;
         if decimator.take(s.t, s.dt) {
+            integ.record_output();
             write_epoch(&integ, &earth, &mut writer, &mut std, &mut err)?;
         }
         if n.is_multiple_of(65_536) {
@@ -212,6 +251,14 @@ where
     std.finish()?;
     err.finish()?;
     write_rejections(&settings.out, &integ)?;
+    if aiding.smooth {
+        write_smoothed(
+            &earth,
+            &settings.out.join("smoothed"),
+            settings.week,
+            &integ,
+        )?;
+    }
     if let Some(e) = failure {
         return Err(anyhow::Error::new(e).context(format!(
             "stopped after {n} samples; {epochs} epochs up to t = {last_t} were written to {}",
@@ -263,6 +310,11 @@ pub struct AidingOptions {
     #[arg(long)]
     #[serde(default)]
     pub scale_factors: bool,
+    /// Also write the Rauch–Tung–Striebel smoothed trajectory (forward-backward) at
+    /// the output rate into `OUT/smoothed/` (the forward result stays in `OUT/`).
+    #[arg(long)]
+    #[serde(default)]
+    pub smooth: bool,
     /// Angle random walk (e.g. `0.1 deg/sqrt(h)`; default from --imu-grade).
     #[arg(long, value_name = "ARW")]
     pub arw: Option<String>,
@@ -311,7 +363,7 @@ impl AidingOptions {
     /// `self` with missing fields taken from `other`.
     pub fn or(self, other: AidingOptions) -> AidingOptions {
         macro_rules! pick {
-            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors } };
+            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth } };
         }
         pick!(
             gnss,
@@ -458,6 +510,7 @@ impl AidingOptions {
             bail!("--propagation-interval must be positive");
         }
         Ok(Some(Aiding {
+            smooth: self.smooth,
             fixes,
             config: IntegrationConfig {
                 noise,

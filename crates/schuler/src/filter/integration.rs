@@ -141,6 +141,8 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     pub nis: Vec<(f64, Kind, f64, usize)>,
     /// Counters.
     pub counts: Counts,
+    /// The record for the smoother, when smoothing.
+    smoother: Option<super::smoother::SmootherLog>,
 }
 
 fn block(p: &DMatrix<f64>, o: usize) -> Matrix3<f64> {
@@ -187,7 +189,32 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             skipped: Vec::new(),
             nis: Vec::new(),
             counts: Counts::default(),
+            smoother: None,
         }
+    }
+
+    /// Keep what the smoother needs (covariances, transitions, feedback, and the
+    /// state at each [`Integrator::record_output`]).
+    pub fn with_smoother(mut self) -> Self {
+        let mut log = super::smoother::SmootherLog::default();
+        log.start(self.mech.state().t, &self.kf.p);
+        self.smoother = Some(log);
+        self
+    }
+
+    /// Record the current instant as an output of the smoothed trajectory.
+    pub fn record_output(&mut self) {
+        if let Some(log) = self.smoother.as_mut() {
+            log.output(self.mech.frame(), self.estimates);
+        }
+    }
+
+    /// The smoothed trajectory at the recorded outputs (empty without
+    /// [`Integrator::with_smoother`]).
+    pub fn smoothed(&self) -> Vec<super::smoother::Smoothed> {
+        self.smoother
+            .as_ref()
+            .map_or_else(Vec::new, |log| log.smooth(&self.earth, &self.model.layout))
     }
 
     /// The mechanization (current state).
@@ -257,7 +284,14 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
         let means = self.interval.means(self.mech.frame());
         let (phi, qd) = self.model.transition(&means);
-        self.kf.predict(&phi, &qd);
+        match self.smoother.as_mut() {
+            Some(log) => {
+                let p_post = self.kf.p.clone();
+                self.kf.predict(&phi, &qd);
+                log.propagated(means.frame.t, &p_post, phi, &self.kf.p);
+            }
+            None => self.kf.predict(&phi, &qd),
+        }
         self.interval = Interval::default();
     }
 
@@ -346,6 +380,9 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
                     Kind::GnssVelocity => self.counts.velocity += 1,
                 }
                 self.feed_back(&u.dx);
+                if let Some(log) = self.smoother.as_mut() {
+                    log.feedback(&u.dx, &self.kf.p);
+                }
                 true
             }
             Err(rejection) => {

@@ -8,6 +8,7 @@
 //! - [`interval`]: the sums over one propagation interval;
 //! - [`measurement`]: GNSS position and velocity with lever arm;
 //! - [`integration`]: the loosely coupled INS/GNSS filter loop;
+//! - [`smoother`]: the Rauch–Tung–Striebel backward pass;
 //! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
 //!   innovation gate.
 
@@ -18,6 +19,7 @@ pub mod kalman;
 pub mod layout;
 pub mod measurement;
 pub mod noise;
+pub mod smoother;
 
 pub use error_model::{ErrorModel, IntervalMeans};
 pub use integration::{GnssFix, IntegrationConfig, Integrator, SensorEstimates};

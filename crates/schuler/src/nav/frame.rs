@@ -78,6 +78,27 @@ pub fn corrected_ecef(
     (r, v, q_be)
 }
 
+/// The NED state at ECEF position `r`, ECEF velocity `v_e` and body-to-ECEF attitude
+/// `q_be` (defined everywhere but exactly at a pole, where north is undefined).
+pub fn nav_state_from_ecef<E: EarthModel>(
+    earth: &E,
+    t: f64,
+    r: &Vector3<f64>,
+    v_e: &Vector3<f64>,
+    q_be: &UnitQuaternion<f64>,
+) -> NavState {
+    let pos = earth.ecef_to_geodetic(r);
+    let c_ne = crate::earth::c_ne(pos.lat, pos.lon);
+    let q_en =
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c_ne.transpose()));
+    NavState {
+        t,
+        pos,
+        v_n: c_ne.transpose() * v_e,
+        q_bn: q_en * q_be,
+    }
+}
+
 impl<E: EarthModel> ErrorFrame for LocalLevel<E> {
     fn frame(&self) -> FrameSnapshot {
         let s = self.state();
@@ -104,21 +125,10 @@ impl<E: EarthModel> ErrorFrame for LocalLevel<E> {
         let f = self.frame();
         let (r, v, q_be) = corrected_ecef(&f, errors);
         let earth = *self.earth();
-        let pos = earth.ecef_to_geodetic(&r);
+        let mut state = nav_state_from_ecef(&earth, f.t, &r, &v, &q_be);
         // Keep the longitude on the branch it was on (ECEF gives it in (−π, π]).
         let tau = std::f64::consts::TAU;
-        let lon = pos.lon + ((self.state().pos.lon - pos.lon) / tau).round() * tau;
-        let pos = crate::earth::Geodetic::new(pos.lat, lon, pos.h);
-        let c_ne = crate::earth::c_ne(pos.lat, pos.lon);
-        let q_en = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-            c_ne.transpose(),
-        ));
-        let state = NavState {
-            t: f.t,
-            pos,
-            v_n: c_ne.transpose() * v,
-            q_bn: q_en * q_be,
-        };
+        state.pos.lon += ((self.state().pos.lon - state.pos.lon) / tau).round() * tau;
         *self = LocalLevel::new(earth, state)
             .with_corrections(self.corrections())
             .with_history(self.history());
