@@ -69,12 +69,16 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
             scale_factors: true,
             lever_arm: Vector3::zeros(),
             gate: Gate::Level(1e-4),
+            reset_after: 5,
             propagation_interval: 1.0,
             init_pos_std: Vector3::repeat(0.1),
             init_vel_std: Vector3::repeat(0.01),
             init_att_std: Vector3::repeat(0.01f64.to_radians()),
+            init_sensor_std: None,
         },
         smooth: false,
+        names: schuler_cli::commands::aided::OutputNames::SCHULER,
+        initial_errors: Default::default(),
     };
     (settings, aiding)
 }
@@ -89,7 +93,8 @@ fn bench_aided(c: &mut Criterion) {
             b.iter(|| {
                 let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
                 let writer = NavWriter::create(&settings.out, settings.week).expect("create");
-                navigate_aided(Wgs84, &settings, &aiding, &mut reader, writer, |_| {}).expect("navigate")
+                navigate_aided(Wgs84, &settings, &aiding, &mut reader, writer, |_| {})
+                    .expect("navigate")
             })
         });
     }

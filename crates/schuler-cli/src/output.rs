@@ -195,7 +195,28 @@ impl NavWriter {
         Self::open(dir, week, Some(geometry))
     }
 
+    /// As [`NavWriter::create_extended`], with the navigation text named `txt_name`
+    /// (e.g. KF-GINS's `KF_GINS_Navresult.nav`).
+    pub fn create_named<E: EarthModel>(
+        dir: &Path,
+        txt_name: &str,
+        week: u32,
+        earth: &E,
+    ) -> Result<Self> {
+        let geometry = (earth.semi_major_axis(), earth.eccentricity_squared());
+        Self::open_named(dir, txt_name, week, Some(geometry))
+    }
+
     fn open(dir: &Path, week: u32, extended: Option<(f64, f64)>) -> Result<Self> {
+        Self::open_named(dir, "nav.txt", week, extended)
+    }
+
+    fn open_named(
+        dir: &Path,
+        txt_name: &str,
+        week: u32,
+        extended: Option<(f64, f64)>,
+    ) -> Result<Self> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
         let open = |name: &str| -> Result<(BufWriter<File>, PathBuf)> {
@@ -203,7 +224,7 @@ impl NavWriter {
             let f = File::create(&p).with_context(|| format!("cannot create {}", p.display()))?;
             Ok((BufWriter::with_capacity(1 << 20, f), p))
         };
-        let (txt, txt_path) = open("nav.txt")?;
+        let (txt, txt_path) = open(txt_name)?;
         let (mut csv, csv_path) = open("nav.csv")?;
         let header = if extended.is_some() {
             CSV_HEADER_EXTENDED

@@ -217,10 +217,12 @@ fn run_with(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool) ->
         scale_factors: false,
         lever_arm: Vector3::from(LEVER),
         gate: Gate::Level(1e-4),
+        reset_after: 5,
         propagation_interval: 1.0,
         init_pos_std: Vector3::repeat(0.05),
         init_vel_std: Vector3::repeat(0.02),
         init_att_std: Vector3::new(0.05, 0.05, 0.2).map(f64::to_radians),
+        init_sensor_std: None,
     };
     let mut imu = ImuSimulator::new(model, seed);
     let start = d.truth[0];

@@ -22,6 +22,32 @@ const DPH: f64 = 3600.0 * 180.0 / std::f64::consts::PI;
 const MGAL: f64 = 1e5;
 const PPM: f64 = 1e6;
 
+/// File names of an aided run's outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputNames {
+    /// Navigation result (KF-GINS text).
+    pub nav: &'static str,
+    /// Standard deviations.
+    pub std: &'static str,
+    /// Sensor errors.
+    pub imu_err: &'static str,
+}
+
+impl OutputNames {
+    /// schuler's own names.
+    pub const SCHULER: OutputNames = OutputNames {
+        nav: "nav.txt",
+        std: "std.txt",
+        imu_err: "imu_err.txt",
+    };
+    /// KF-GINS's names.
+    pub const KF_GINS: OutputNames = OutputNames {
+        nav: "KF_GINS_Navresult.nav",
+        std: "KF_GINS_STD.txt",
+        imu_err: "KF_GINS_IMU_ERR.txt",
+    };
+}
+
 /// What aiding a run has.
 #[derive(Debug, Clone)]
 pub struct Aiding {
@@ -31,6 +57,10 @@ pub struct Aiding {
     pub config: IntegrationConfig,
     /// Write the smoothed trajectory too.
     pub smooth: bool,
+    /// Output file names.
+    pub names: OutputNames,
+    /// Sensor errors known at the start (removed from the first sample on).
+    pub initial_errors: schuler::filter::SensorEstimates,
 }
 
 /// What an aided run did, beyond [`NavSummary`].
@@ -176,6 +206,9 @@ fn write_rejections<E: EarthModel>(dir: &Path, integ: &Integrator<LocalLevel<E>,
         };
         (k.t, format!("{},gnss,{why},,\n", k.t))
     }));
+    rows.extend(integ.gate_resets.iter().map(|t| {
+        (*t, format!("{t},gnss_position,accepted without the gate after consecutive refusals (filter reset),,\n"))
+    }));
     rows.sort_by(|a, b| a.0.total_cmp(&b.0));
     for (_, r) in rows {
         s.push_str(&r);
@@ -210,13 +243,14 @@ where
         settings.init_vel,
         settings.init_att,
     );
-    let mut integ = Integrator::new(LocalLevel::new(earth, init), earth, aiding.config);
+    let mut integ = Integrator::new(LocalLevel::new(earth, init), earth, aiding.config)
+        .with_estimates(aiding.initial_errors);
     if aiding.smooth {
         integ = integ.with_smoother();
     }
     integ.prime(&first);
-    let mut std = Table::create(&settings.out, "std.txt")?;
-    let mut err = Table::create(&settings.out, "imu_err.txt")?;
+    let mut std = Table::create(&settings.out, aiding.names.std)?;
+    let mut err = Table::create(&settings.out, aiding.names.imu_err)?;
     let mut fixes = aiding.fixes.iter().copied().peekable();
     let mut decimator = Decimator::new(settings.output_rate);
     decimator.take(first.t, first.dt);
@@ -511,6 +545,8 @@ impl AidingOptions {
         }
         Ok(Some(Aiding {
             smooth: self.smooth,
+            names: OutputNames::SCHULER,
+            initial_errors: Default::default(),
             fixes,
             config: IntegrationConfig {
                 noise,
@@ -519,11 +555,13 @@ impl AidingOptions {
                     .lever_arm
                     .map_or(Vector3::zeros(), |t| Vector3::from(t.0)),
                 gate,
+                reset_after: 5,
                 propagation_interval,
                 init_pos_std: triple("init-pos-std", &self.init_pos_std, [1.0, 1.0, 1.0])?,
                 init_vel_std: triple("init-vel-std", &self.init_vel_std, [0.1, 0.1, 0.1])?,
                 // Roll, pitch, yaw std taken about north, east, down (level attitude).
                 init_att_std: att.map(f64::to_radians),
+                init_sensor_std: None,
             },
         }))
     }

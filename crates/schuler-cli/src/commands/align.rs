@@ -68,7 +68,8 @@ pub struct AlignOptions {
     /// measurement window (default 1 s; the averaging filter's band is 1/block).
     #[arg(long, value_name = "TIME", allow_hyphen_values = true)]
     pub block: Option<String>,
-    /// Noise model the filter assumes (default navigation).
+    /// Noise model the filters assume (default: navigation for alignment, tactical
+    /// with --gnss).
     #[arg(long, value_enum)]
     pub imu_grade: Option<GradeChoice>,
     /// External heading instead of gyrocompassing: `DEG` or `DEG,STD_DEG` (default std

@@ -5,6 +5,7 @@ pub mod aided;
 pub mod align;
 pub mod channel;
 pub mod demo;
+pub mod kf_gins;
 pub mod nav;
 pub mod platform;
 pub mod simulate;

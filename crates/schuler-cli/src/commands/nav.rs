@@ -239,6 +239,11 @@ pub struct NavArgs {
     /// removed; --init-att is then not needed. Writes align.json beside nav.txt.
     #[arg(long)]
     pub align: bool,
+    /// Run a KF-GINS configuration file (its paths, initial state, IMU noise and lever
+    /// arm, in its units) and write KF-GINS's output files into its outputpath; the
+    /// other options do not apply.
+    #[arg(long, value_name = "FILE.yaml", conflicts_with_all = ["imu", "config"])]
+    pub kf_gins_config: Option<PathBuf>,
     /// Alignment options (with --align).
     #[command(flatten)]
     pub alignment: AlignOptions,
@@ -799,9 +804,21 @@ where
 
 /// `schuler nav`.
 pub fn run(args: NavArgs) -> Result<()> {
+    if let Some(path) = &args.kf_gins_config {
+        return super::kf_gins::run(path);
+    }
     let (mut settings, mechanization, (align_on, align_opts), aiding_opts) = parse_nav_args(args)?;
-    // --imu-grade serves the alignment and the filter alike.
-    let grade = align_opts.imu_grade.unwrap_or_default();
+    // --imu-grade serves the alignment and the filter alike. Its default is
+    // navigation grade for alignment (gyrocompassing needs it) but tactical for the
+    // filter: an optimistic noise model makes the gate refuse good fixes, a
+    // pessimistic one only costs a little accuracy.
+    let grade = align_opts
+        .imu_grade
+        .unwrap_or(if aiding_opts.gnss.is_some() {
+            super::align::GradeChoice::Tactical
+        } else {
+            super::align::GradeChoice::Navigation
+        });
     let align = align_on.then(|| align_opts.resolve()).transpose()?;
     let aiding: Option<Aiding> = aiding_opts.resolve(grade.noise()?)?;
     if aiding.is_some() && mechanization.choice == MechanizationChoice::Wander {
@@ -886,6 +903,13 @@ pub fn run(args: NavArgs) -> Result<()> {
             c.skipped,
             summary.mean_nis_per_dof
         );
+        let tried = c.position + c.velocity + c.rejected;
+        if c.rejected * 10 > tried {
+            eprintln!(
+                "warning: the gate refused {} of {} GNSS measurements: the IMU noise model is probably too optimistic for this sensor (--imu-grade, --arw, --gyro-bias-std, ...)",
+                c.rejected, tried
+            );
+        }
         println!(
             "wrote {} epochs to {} (and nav.csv, std.txt, imu_err.txt, rejected.csv)",
             summary.nav.epochs,

@@ -79,6 +79,11 @@ impl ErrorModel {
             a[(Layout::GYRO_BIAS + i, Layout::GYRO_BIAS + i)] = -1.0 / self.noise.gyro_bias_tau;
             a[(Layout::ACCEL_BIAS + i, Layout::ACCEL_BIAS + i)] = -1.0 / self.noise.accel_bias_tau;
         }
+        for o in [l.gyro_scale, l.accel_scale].into_iter().flatten() {
+            for i in 0..3 {
+                a[(o + i, o + i)] = -1.0 / self.noise.scale_tau;
+            }
+        }
         if let Some(sg) = l.gyro_scale {
             put(&mut a, att, sg, &(-c_bc * Matrix3::from_diagonal(&m.w_b)));
         }
@@ -120,6 +125,19 @@ impl ErrorModel {
         );
         if let Some(b) = l.baro_bias {
             q[(b, b)] = self.baro_bias_walk * self.baro_bias_walk;
+        }
+        if nz.scale_tau.is_finite() {
+            // Gauss–Markov scale factors: density 2σ²/τ.
+            for (o, s) in [
+                (l.gyro_scale, nz.gyro_scale),
+                (l.accel_scale, nz.accel_scale),
+            ] {
+                if let Some(o) = o {
+                    for i in 0..3 {
+                        q[(o + i, o + i)] = 2.0 * s[i] * s[i] / nz.scale_tau;
+                    }
+                }
+            }
         }
         q
     }

@@ -45,6 +45,11 @@ pub struct IntegrationConfig {
     pub lever_arm: Vector3<f64>,
     /// Innovation gate.
     pub gate: Gate,
+    /// After this many GNSS positions in a row refused by the gate, accept the next
+    /// one without the test (the filter has lost the GNSS track, e.g. after a long
+    /// outage with an optimistic noise model; refusing forever would never recover).
+    /// 0: never.
+    pub reset_after: u32,
     /// Longest covariance propagation step [s].
     pub propagation_interval: f64,
     /// Initial standard deviations: position (NED) [m].
@@ -53,6 +58,9 @@ pub struct IntegrationConfig {
     pub init_vel_std: Vector3<f64>,
     /// Initial attitude standard deviations (about north, east, down) [rad].
     pub init_att_std: Vector3<f64>,
+    /// Initial standard deviations of gyro bias, accelerometer bias, gyro and
+    /// accelerometer scale factors, when they differ from the noise model's.
+    pub init_sensor_std: Option<[Vector3<f64>; 4]>,
 }
 
 /// A measurement the gate refused.
@@ -141,6 +149,9 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     pub nis: Vec<(f64, Kind, f64, usize)>,
     /// Counters.
     pub counts: Counts,
+    /// Times at which the gate was bypassed after `reset_after` refusals in a row.
+    pub gate_resets: Vec<f64>,
+    consecutive_rejections: u32,
     /// The record for the smoother, when smoothing.
     smoother: Option<super::smoother::SmootherLog>,
 }
@@ -169,6 +180,20 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         let rot = |std: &Vector3<f64>| {
             c * Matrix3::from_diagonal(&std.component_mul(std)) * c.transpose()
         };
+        if let Some(sd) = cfg.init_sensor_std {
+            let blocks = [
+                Some(Layout::GYRO_BIAS),
+                Some(Layout::ACCEL_BIAS),
+                layout.gyro_scale,
+                layout.accel_scale,
+            ];
+            for (o, v) in blocks.into_iter().zip(sd) {
+                if let Some(o) = o {
+                    p.fixed_view_mut::<3, 3>(o, o)
+                        .copy_from(&Matrix3::from_diagonal(&v.component_mul(&v)));
+                }
+            }
+        }
         for (o, std) in [
             (Layout::POS, cfg.init_pos_std),
             (Layout::VEL, cfg.init_vel_std),
@@ -189,8 +214,16 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             skipped: Vec::new(),
             nis: Vec::new(),
             counts: Counts::default(),
+            gate_resets: Vec::new(),
+            consecutive_rejections: 0,
             smoother: None,
         }
+    }
+
+    /// Start from sensor-error estimates other than zero (e.g. a previous run's).
+    pub fn with_estimates(mut self, estimates: SensorEstimates) -> Self {
+        self.estimates = estimates;
+        self
     }
 
     /// Keep what the smoother needs (covariances, transitions, feedback, and the
@@ -372,8 +405,19 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 
     /// Gate a measurement and, if accepted, update and feed back.
     pub fn apply(&mut self, t: f64, m: Measurement) -> bool {
-        match self.kf.update(&m.z, &m.h, &m.r, self.cfg.gate) {
+        let position = m.kind == Kind::GnssPosition;
+        let reset = position
+            && self.cfg.reset_after > 0
+            && self.consecutive_rejections >= self.cfg.reset_after;
+        let gate = if reset { Gate::Off } else { self.cfg.gate };
+        match self.kf.update(&m.z, &m.h, &m.r, gate) {
             Ok(u) => {
+                if reset {
+                    self.gate_resets.push(t);
+                }
+                if position {
+                    self.consecutive_rejections = 0;
+                }
                 self.nis.push((t, m.kind, u.nis, m.z.len()));
                 match m.kind {
                     Kind::GnssPosition => self.counts.position += 1,
@@ -386,6 +430,9 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
                 true
             }
             Err(rejection) => {
+                if position {
+                    self.consecutive_rejections += 1;
+                }
                 self.counts.rejected += 1;
                 self.rejected.push(Rejected {
                     t,

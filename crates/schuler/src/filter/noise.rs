@@ -34,6 +34,9 @@ pub struct ImuNoise {
     pub gyro_scale: Vector3<f64>,
     /// Prior standard deviation of the accelerometer scale-factor error.
     pub accel_scale: Vector3<f64>,
+    /// Gauss–Markov correlation time of the scale-factor errors [s] (infinite:
+    /// constants); finite, they vary with the stationary standard deviations above.
+    pub scale_tau: f64,
 }
 
 fn prior(t: &TriadModel) -> Vector3<f64> {
@@ -68,6 +71,7 @@ impl ImuNoise {
             accel_bias_tau: f64::INFINITY,
             gyro_scale: m.gyro.scale.abs(),
             accel_scale: m.accel.scale.abs(),
+            scale_tau: f64::INFINITY,
         }
     }
 }

@@ -1,0 +1,236 @@
+//! `schuler nav --kf-gins-config FILE.yaml`: a drop-in for KF-GINS
+//! (i2Nav-WHU/KF-GINS). Reads its configuration — paths, processing interval,
+//! initial state and standard deviations, IMU noise, antenna lever arm, in the units
+//! KF-GINS defines (deg, deg/h, mGal, ppm, deg/sqrt(h), m/s/sqrt(h), hours) — and
+//! writes `KF_GINS_Navresult.nav`, `KF_GINS_IMU_ERR.txt` and `KF_GINS_STD.txt` into its
+//! `outputpath` at the IMU rate, with KF-GINS's columns and units (whitespace
+//! separated). The filter is the 21-state one with Gauss–Markov biases and scale
+//! factors, as KF-GINS's. Relative paths are taken from the working directory, as
+//! KF-GINS does.
+
+use super::aided::{Aiding, OutputNames};
+use super::nav::{EarthChoice, NavSettings};
+use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions};
+use anyhow::{Context, Result, bail};
+use nalgebra::Vector3;
+use schuler::earth::Geodetic;
+use schuler::filter::integration::SensorEstimates;
+use schuler::filter::{Gate, IntegrationConfig};
+use schuler::rotation::Euler;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// KF-GINS's `imunoise` table.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ImuNoiseYaml {
+    arw: [f64; 3],
+    vrw: [f64; 3],
+    gbstd: [f64; 3],
+    abstd: [f64; 3],
+    gsstd: [f64; 3],
+    asstd: [f64; 3],
+    corrtime: f64,
+}
+
+/// A KF-GINS configuration file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KfGinsYaml {
+    imupath: PathBuf,
+    gnsspath: PathBuf,
+    outputpath: PathBuf,
+    imudatalen: u32,
+    imudatarate: f64,
+    starttime: f64,
+    endtime: f64,
+    initpos: [f64; 3],
+    initvel: [f64; 3],
+    initatt: [f64; 3],
+    initgyrbias: [f64; 3],
+    initaccbias: [f64; 3],
+    initgyrscale: [f64; 3],
+    initaccscale: [f64; 3],
+    initposstd: [f64; 3],
+    initvelstd: [f64; 3],
+    initattstd: [f64; 3],
+    initbgstd: Option<[f64; 3]>,
+    initbastd: Option<[f64; 3]>,
+    initsgstd: Option<[f64; 3]>,
+    initsastd: Option<[f64; 3]>,
+    imunoise: ImuNoiseYaml,
+    antlever: [f64; 3],
+}
+
+const DEG_PER_H: f64 = std::f64::consts::PI / 180.0 / 3600.0;
+
+/// A run set up from a KF-GINS configuration.
+#[derive(Debug, Clone)]
+pub struct KfGinsRun {
+    /// Navigation settings (paths, interval, initial state; output at the IMU rate).
+    pub settings: NavSettings,
+    /// The filter, the GNSS data and the initial sensor errors.
+    pub aiding: Aiding,
+}
+
+fn positive(key: &str, v: &[f64]) -> Result<Vector3<f64>> {
+    if v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+        bail!("{key}: standard deviations must be positive numbers, got {v:?}");
+    }
+    Ok(Vector3::from_column_slice(v))
+}
+
+fn non_negative(key: &str, v: &[f64]) -> Result<Vector3<f64>> {
+    if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        bail!("{key}: must not be negative, got {v:?}");
+    }
+    Ok(Vector3::from_column_slice(v))
+}
+
+/// Read and check a KF-GINS configuration.
+pub fn load(path: &Path) -> Result<KfGinsRun> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let y: KfGinsYaml =
+        serde_saphyr::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    if y.imudatalen != 7 {
+        bail!(
+            "{}: imudatalen: schuler reads the 7-column KF-GINS IMU text (time, 3 gyro, 3 accelerometer increments); got {}",
+            path.display(),
+            y.imudatalen
+        );
+    }
+    if !(y.imudatarate.is_finite() && y.imudatarate > 0.0) {
+        bail!(
+            "{}: imudatarate must be a positive rate in Hz, got {}",
+            path.display(),
+            y.imudatarate
+        );
+    }
+    if !(-90.0..=90.0).contains(&y.initpos[0]) {
+        bail!(
+            "{}: initpos: latitude {} is outside [-90, 90]",
+            path.display(),
+            y.initpos[0]
+        );
+    }
+    let n = &y.imunoise;
+    if !(n.corrtime.is_finite() && n.corrtime > 0.0) {
+        bail!(
+            "{}: imunoise.corrtime must be a positive number of hours, got {}",
+            path.display(),
+            n.corrtime
+        );
+    }
+    let key = |k: &str| format!("{}: {k}", path.display());
+    let tau = n.corrtime * 3600.0;
+    let gb = non_negative(&key("imunoise.gbstd"), &n.gbstd)? * DEG_PER_H;
+    let ab = non_negative(&key("imunoise.abstd"), &n.abstd)? * 1e-5;
+    let gs = non_negative(&key("imunoise.gsstd"), &n.gsstd)? * 1e-6;
+    let as_ = non_negative(&key("imunoise.asstd"), &n.asstd)? * 1e-6;
+    let walk = |s: Vector3<f64>| s * (2.0 / tau).sqrt();
+    let noise = schuler::filter::ImuNoise {
+        arw: non_negative(&key("imunoise.arw"), &n.arw)? * (std::f64::consts::PI / 180.0 / 60.0),
+        vrw: non_negative(&key("imunoise.vrw"), &n.vrw)? / 60.0,
+        gyro_bias: gb,
+        gyro_bias_walk: walk(gb),
+        accel_bias: ab,
+        accel_bias_walk: walk(ab),
+        gyro_bias_tau: tau,
+        accel_bias_tau: tau,
+        gyro_scale: gs,
+        accel_scale: as_,
+        scale_tau: tau,
+    };
+    let init_std =
+        |k: &str, v: Option<[f64; 3]>, default: Vector3<f64>, unit: f64| -> Result<Vector3<f64>> {
+            v.map_or(Ok(default), |v| positive(&key(k), &v).map(|x| x * unit))
+        };
+    let sensor_std = [
+        init_std("initbgstd", y.initbgstd, gb, DEG_PER_H)?,
+        init_std("initbastd", y.initbastd, ab, 1e-5)?,
+        init_std("initsgstd", y.initsgstd, gs, 1e-6)?,
+        init_std("initsastd", y.initsastd, as_, 1e-6)?,
+    ];
+    let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)?;
+    fixes.retain(|f| f.t >= y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));
+    let settings = NavSettings {
+        imu: y.imupath.clone(),
+        read: ImuReadOptions {
+            format: ImuFormat::KfGinsText,
+            layout: Some(ImuLayout::Increments),
+            nominal_dt: Some(1.0 / y.imudatarate),
+            t_start: Some(y.starttime),
+            t_end: (y.endtime >= 0.0).then_some(y.endtime),
+            check_layout: true,
+        },
+        init_pos: Geodetic::from_degrees(y.initpos[0], y.initpos[1], y.initpos[2]),
+        init_vel: Vector3::from(y.initvel),
+        init_att: Euler::from_degrees(y.initatt[0], y.initatt[1], y.initatt[2]),
+        output_rate: None,
+        out: y.outputpath.clone(),
+        earth: EarthChoice::Wgs84,
+        week: 0,
+    };
+    let aiding = Aiding {
+        fixes,
+        config: IntegrationConfig {
+            noise,
+            scale_factors: true,
+            lever_arm: Vector3::from(y.antlever),
+            // KF-GINS has no innovation test; keep ours on at its default level.
+            gate: Gate::Level(1e-4),
+            reset_after: 5,
+            propagation_interval: 1.0,
+            init_pos_std: positive(&key("initposstd"), &y.initposstd)?,
+            init_vel_std: positive(&key("initvelstd"), &y.initvelstd)?,
+            init_att_std: positive(&key("initattstd"), &y.initattstd)?.map(f64::to_radians),
+            init_sensor_std: Some(sensor_std),
+        },
+        smooth: false,
+        names: OutputNames::KF_GINS,
+        initial_errors: SensorEstimates {
+            gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
+            accel_bias: Vector3::from(y.initaccbias) * 1e-5,
+            gyro_scale: Vector3::from(y.initgyrscale) * 1e-6,
+            accel_scale: Vector3::from(y.initaccscale) * 1e-6,
+        },
+    };
+    Ok(KfGinsRun { settings, aiding })
+}
+
+/// Run a KF-GINS configuration end to end.
+pub fn run(path: &Path) -> Result<()> {
+    let started = Instant::now();
+    let KfGinsRun { settings, aiding } = load(path)?;
+    let mut reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
+    let writer = crate::output::NavWriter::create_named(
+        &settings.out,
+        aiding.names.nav,
+        settings.week,
+        &schuler::earth::Wgs84,
+    )?;
+    let summary = super::aided::navigate_aided(
+        schuler::earth::Wgs84,
+        &settings,
+        &aiding,
+        &mut reader,
+        writer,
+        |_| {},
+    )?;
+    let c = summary.counts;
+    println!(
+        "KF-GINS configuration {}: {} samples, {} GNSS fixes ({} position updates, {} rejected, {} outside the IMU data) in {:.2} s; wrote {} epochs to {}",
+        path.display(),
+        summary.nav.samples,
+        aiding.fixes.len(),
+        c.position,
+        c.rejected,
+        c.skipped,
+        started.elapsed().as_secs_f64(),
+        summary.nav.epochs,
+        settings.out.join(aiding.names.nav).display()
+    );
+    Ok(())
+}
