@@ -50,11 +50,10 @@ pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
     }
 }
 
-/// Longitude (or any angle) wrapped to (-180, 180] degrees.
+/// Longitude (or any angle) [rad] in degrees, wrapped to (-180, 180]
+/// ([`schuler::rotation::wrap_pi`]).
 fn wrap_lon_deg(lon_rad: f64) -> f64 {
-    let d = lon_rad.to_degrees();
-    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
-    if w == -180.0 { 180.0 } else { w }
+    schuler::rotation::wrap_pi(lon_rad).to_degrees()
 }
 
 /// Longitude-like angle `x` [deg] in (−180, 180] that stays there when printed
