@@ -4,6 +4,11 @@
 //! and a barometer at 10 Hz, all files written.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use schuler::imu::ImuSample;
+use schuler::nav::NavState;
+use schuler::sim::analytic::Kinematics;
+use schuler::sim::receivers::{BaroReading, GnssFix};
+use schuler::sim::run::{SimSink, simulate};
 use schuler_cli::commands::simulate::simulate_to_dir;
 use std::path::PathBuf;
 
@@ -34,6 +39,30 @@ rate_hz = 10
 noise = "0.5 m"
 "#;
 
+/// Discards everything: the cost of generating the streams alone.
+struct NullSink;
+
+impl SimSink for NullSink {
+    fn imu(
+        &mut self,
+        exact: &ImuSample,
+        measured: &ImuSample,
+        truth: &NavState,
+        kin: &Kinematics,
+    ) -> std::io::Result<()> {
+        std::hint::black_box((exact, measured, truth, kin));
+        Ok(())
+    }
+    fn gnss(&mut self, fix: &GnssFix) -> std::io::Result<()> {
+        std::hint::black_box(fix);
+        Ok(())
+    }
+    fn baro(&mut self, reading: &BaroReading) -> std::io::Result<()> {
+        std::hint::black_box(reading);
+        Ok(())
+    }
+}
+
 fn bench_simulate(c: &mut Criterion) {
     let spec = toml::from_str(SCENARIO).expect("scenario");
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("simulate_bench");
@@ -43,6 +72,9 @@ fn bench_simulate(c: &mut Criterion) {
     group.throughput(Throughput::Elements(samples));
     group.bench_function("maneuvers_1khz_tactical_gnss_baro", |b| {
         b.iter(|| simulate_to_dir(&spec, &dir).expect("simulate"))
+    });
+    group.bench_function("generate_only_1khz_tactical_gnss_baro", |b| {
+        b.iter(|| simulate(&spec, &mut NullSink).expect("simulate"))
     });
     group.finish();
 }
