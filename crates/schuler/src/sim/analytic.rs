@@ -76,7 +76,7 @@ pub fn ecef_truth<E: EarthModel, T: Trajectory + ?Sized>(earth: &E, traj: &T, t:
 }
 
 /// True angular rate and specific force at one instant, body axes FRD.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Kinematics {
     /// `w_ib_b` [rad/s].
     pub w_ib_b: Vector3<f64>,
@@ -204,7 +204,10 @@ struct GeodeticExtras {
 /// `sin lat`, `cos lat` built from one `sin_cos`. Then NED = (north `[−sin lat, 0, cos
 /// lat]`, east `y`, down `[−cos lat, 0, −sin lat]`) and gravity from
 /// [`EarthModel::local_from_sin_cos`], the mechanizations' gravity.
-fn geodetic_kinematics<E: EarthModel>(earth: &E, c: &GeodeticEuler) -> (Kinematics, GeodeticExtras) {
+fn geodetic_kinematics<E: EarthModel>(
+    earth: &E,
+    c: &GeodeticEuler,
+) -> (Kinematics, GeodeticExtras) {
     let [lat, lon, hh, roll, pitch, yaw] = c;
     let (sl, cl) = lat[0].sin_cos();
     let (l1, l2) = (lat[1], lat[2]);
