@@ -115,7 +115,8 @@ const MIN_TURN_SPEED: f64 = 0.1;
 fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -> [Jet; 9] {
     let [lat, _lon, h, roll, pitch, yaw, vn, ve, vd] = *x;
     let (a, e2) = (earth.semi_major_axis(), earth.eccentricity_squared());
-    let sl = lat.sin();
+    let (sl, cl) = lat.sin_cos();
+    let (sr, cr) = roll.sin_cos();
     let w = (Jet::constant(1.0) - sl * sl * e2).sqrt();
     let rn = w.recip() * a;
     let rm = (w * w * w).recip() * (a * (1.0 - e2));
@@ -124,7 +125,7 @@ fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -
     if piece.coordinated {
         let v_h = (vn * vn + ve * ve).sqrt();
         if v_h.v > MIN_TURN_SPEED {
-            euler_rate[2] = euler_rate[2] + roll.sin() / roll.cos() * G_TURN / v_h;
+            euler_rate[2] = euler_rate[2] + sr / cr * G_TURN / v_h;
         }
     }
     let accel = piece.d_vel.map(|d| s * d);
@@ -136,8 +137,7 @@ fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -
             let v_b = c_bn.transpose().mul_vec(&v_n);
             // w_nb_b from Euler rates (Titterton & Weston eq. 3.52 inverted).
             let [dr, dp, dy] = euler_rate;
-            let (sr, cr) = (roll.sin(), roll.cos());
-            let (sp, cp) = (pitch.sin(), pitch.cos());
+            let (sp, cp) = pitch.sin_cos();
             let w = [dr - dy * sp, dp * cr + dy * sr * cp, dy * cr * cp - dp * sr];
             let wxv = [
                 w[1] * v_b[2] - w[2] * v_b[1],
@@ -149,7 +149,7 @@ fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -
     };
     [
         vn / (rm + h),
-        ve / ((rn + h) * lat.cos()),
+        ve / ((rn + h) * cl),
         -vd,
         euler_rate[0],
         euler_rate[1],
