@@ -317,11 +317,11 @@ pub fn push_imu_line(out: &mut Vec<u8>, s: &ImuSample, sep: u8, digits: ImuDigit
     let increments = [a.x, a.y, a.z, v.x, v.y, v.z];
     match digits {
         ImuDigits::Shortest => {
-            let mut ryu = ryu::Buffer::new();
-            out.extend_from_slice(ryu.format(s.t).as_bytes());
+            let mut num = zmij::Buffer::new();
+            out.extend_from_slice(num.format(s.t).as_bytes());
             for x in increments {
                 out.push(sep);
-                out.extend_from_slice(ryu.format(x).as_bytes());
+                out.extend_from_slice(num.format(x).as_bytes());
             }
         }
         ImuDigits::Significant(d) => {

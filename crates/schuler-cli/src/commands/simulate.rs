@@ -65,14 +65,14 @@ impl Out {
 /// Appends numbers separated by `sep` in shortest round-trip form.
 struct Line {
     buf: Vec<u8>,
-    ryu: ryu::Buffer,
+    num: zmij::Buffer,
 }
 
 impl Line {
     fn new() -> Self {
         Self {
             buf: Vec::with_capacity(512),
-            ryu: ryu::Buffer::new(),
+            num: zmij::Buffer::new(),
         }
     }
 
@@ -85,7 +85,7 @@ impl Line {
         if !self.buf.is_empty() {
             self.buf.push(sep);
         }
-        self.buf.extend_from_slice(self.ryu.format(x).as_bytes());
+        self.buf.extend_from_slice(self.num.format(x).as_bytes());
         self
     }
 
@@ -146,7 +146,7 @@ impl EpochText {
 
     /// Append the lines of `epochs`.
     fn push(&mut self, epochs: &[ImuEpoch]) {
-        let mut ryu = ryu::Buffer::new();
+        let mut num = zmij::Buffer::new();
         for e in epochs {
             // imu.txt (KF-GINS) and imu.csv: the measured sample.
             let start = self.imu_txt.len();
@@ -158,17 +158,17 @@ impl EpochText {
             self.truth_nav.extend_from_slice(b"0 ");
             let start = self.truth_nav.len();
             self.truth_nav
-                .extend_from_slice(ryu.format(e.truth.t).as_bytes());
+                .extend_from_slice(num.format(e.truth.t).as_bytes());
             for x in nav_fields(&e.truth) {
                 self.truth_nav.push(b' ');
-                self.truth_nav.extend_from_slice(ryu.format(x).as_bytes());
+                self.truth_nav.extend_from_slice(num.format(x).as_bytes());
             }
             push_as_csv(&mut self.truth_csv, &self.truth_nav[start..]);
             self.truth_nav.push(b'\n');
             let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
             for x in [w.x, w.y, w.z, f.x, f.y, f.z] {
                 self.truth_csv.push(b',');
-                self.truth_csv.extend_from_slice(ryu.format(x).as_bytes());
+                self.truth_csv.extend_from_slice(num.format(x).as_bytes());
             }
             self.truth_csv.push(b'\n');
         }
