@@ -165,10 +165,16 @@ fn derivative_value<E: EarthModel>(earth: &E, piece: &Piece, tau: f64, x: &[f64;
     derivative(earth, piece, Jet::constant(tau), &x.map(Jet::constant)).map(|j| j.v)
 }
 
-/// The knot at state `x`: first derivatives from the equations, second derivatives by
-/// differentiating them along the motion (jets seeded with `x'`).
-fn knot<E: EarthModel>(earth: &E, piece: &Piece, t: f64, tau: f64, x: &[f64; 9]) -> Knot {
-    let d1 = derivative_value(earth, piece, tau, x);
+/// The knot at state `x` whose first derivatives `d1` come from the equations:
+/// second derivatives by differentiating them along the motion (jets seeded with `x'`).
+fn knot<E: EarthModel>(
+    earth: &E,
+    piece: &Piece,
+    t: f64,
+    tau: f64,
+    x: &[f64; 9],
+    d1: &[f64; 9],
+) -> Knot {
     let xj: [Jet; 9] = std::array::from_fn(|i| Jet {
         v: x[i],
         d: d1[i],
@@ -285,11 +291,13 @@ impl<E: EarthModel> MotionBuilder<E> {
         let h = piece.duration / n as f64;
         let mut x = self.x;
         let mut knots = Vec::with_capacity(n + 1);
+        // The derivative at each knot is also the first stage of the next step.
+        let mut d1 = derivative_value(&self.earth, piece, 0.0, &x);
         if self.knots.is_empty() {
-            knots.push(knot(&self.earth, piece, self.t, 0.0, &x));
+            knots.push(knot(&self.earth, piece, self.t, 0.0, &x, &d1));
         }
         for k in 0..n {
-            x = rk4_step(&self.earth, piece, k as f64 * h, h, &x);
+            x = rk4_step(&self.earth, piece, k as f64 * h, h, &x, &d1);
             let ok = x.iter().all(|v| v.is_finite()) && x[0].abs() < 89.9f64.to_radians();
             if !ok {
                 return Err(MotionError::OutOfDomain {
@@ -298,7 +306,8 @@ impl<E: EarthModel> MotionBuilder<E> {
                 });
             }
             let tau1 = (k + 1) as f64 * h;
-            knots.push(knot(&self.earth, piece, self.t + tau1, tau1, &x));
+            d1 = derivative_value(&self.earth, piece, tau1, &x);
+            knots.push(knot(&self.earth, piece, self.t + tau1, tau1, &x, &d1));
         }
         self.knots.extend(knots);
         self.x = x;
@@ -345,13 +354,20 @@ pub fn generate<E: EarthModel>(
     })
 }
 
-/// One classical Runge–Kutta step of length `h` from `tau`.
-fn rk4_step<E: EarthModel>(earth: &E, piece: &Piece, tau: f64, h: f64, x: &[f64; 9]) -> [f64; 9] {
+/// One classical Runge–Kutta step of length `h` from `tau`, given the first stage
+/// `k1 = x'(tau)`.
+fn rk4_step<E: EarthModel>(
+    earth: &E,
+    piece: &Piece,
+    tau: f64,
+    h: f64,
+    x: &[f64; 9],
+    k1: &[f64; 9],
+) -> [f64; 9] {
     let add = |a: &[f64; 9], b: &[f64; 9], s: f64| -> [f64; 9] {
         std::array::from_fn(|i| a[i] + s * b[i])
     };
-    let k1 = derivative_value(earth, piece, tau, x);
-    let k2 = derivative_value(earth, piece, tau + 0.5 * h, &add(x, &k1, 0.5 * h));
+    let k2 = derivative_value(earth, piece, tau + 0.5 * h, &add(x, k1, 0.5 * h));
     let k3 = derivative_value(earth, piece, tau + 0.5 * h, &add(x, &k2, 0.5 * h));
     let k4 = derivative_value(earth, piece, tau + h, &add(x, &k3, h));
     std::array::from_fn(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
