@@ -59,11 +59,10 @@ pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
     }
 }
 
-/// Longitude (or any angle) wrapped to (-180, 180] degrees.
+/// Longitude (or any angle) [rad] in degrees, wrapped to (-180, 180]
+/// ([`schuler::rotation::wrap_pi`]).
 fn wrap_lon_deg(lon_rad: f64) -> f64 {
-    let d = lon_rad.to_degrees();
-    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
-    if w == -180.0 { 180.0 } else { w }
+    schuler::rotation::wrap_pi(lon_rad).to_degrees()
 }
 
 /// Longitude-like angle `x` [deg] in (−180, 180] that stays there when printed
@@ -329,25 +328,62 @@ pub fn write_truth_text(path: &Path, states: impl Iterator<Item = NavState>) -> 
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// How [`push_imu_line`] prints the numbers of an IMU line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImuDigits {
+    /// Every number (time included) in shortest round-trip form: nothing is lost, and
+    /// the file reads back to the same f64s.
+    Shortest,
+    /// Time to 1e-9 s, increments in exponent notation with this many significant
+    /// digits (clamped to 1..=17; 17 round-trip every f64 exactly; KF-GINS data sets
+    /// carry about 13).
+    Significant(usize),
+}
+
+/// Append one KF-GINS IMU line `t dtheta_xyz dvel_xyz` [s, rad, m/s; FRD], fields
+/// separated by `sep` (b' ' for KF-GINS text, b',' for CSV), without the newline.
+pub fn push_imu_line(out: &mut Vec<u8>, s: &ImuSample, sep: u8, digits: ImuDigits) {
+    let (a, v) = (s.dtheta, s.dvel);
+    let increments = [a.x, a.y, a.z, v.x, v.y, v.z];
+    match digits {
+        ImuDigits::Shortest => {
+            let mut num = zmij::Buffer::new();
+            out.extend_from_slice(num.format(s.t).as_bytes());
+            for x in increments {
+                out.push(sep);
+                out.extend_from_slice(num.format(x).as_bytes());
+            }
+        }
+        ImuDigits::Significant(d) => {
+            let p = d.clamp(1, 17) - 1;
+            // Writing to a Vec cannot fail.
+            let _ = write!(out, "{:.9}", s.t);
+            for x in increments {
+                out.push(sep);
+                let _ = write!(out, "{x:.p$e}");
+            }
+        }
+    }
+}
+
 /// Write samples as a KF-GINS IMU text file: `t dtheta_xyz dvel_xyz`, time to 1e-9 s
 /// and increments in exponent notation with `digits` significant digits (17 round-trip
-/// every f64 exactly; KF-GINS data sets carry about 13).
+/// every f64 exactly; KF-GINS data sets carry about 13); lines from
+/// [`push_imu_line`].
 pub fn write_imu_text(
     path: &Path,
     samples: impl Iterator<Item = ImuSample>,
     digits: usize,
 ) -> Result<()> {
-    let p = digits.clamp(1, 17) - 1;
     let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut w = BufWriter::with_capacity(1 << 20, f);
+    let mut line = Vec::with_capacity(256);
     for s in samples {
-        let (a, v) = (s.dtheta, s.dvel);
-        writeln!(
-            w,
-            "{:.9} {:.p$e} {:.p$e} {:.p$e} {:.p$e} {:.p$e} {:.p$e}",
-            s.t, a.x, a.y, a.z, v.x, v.y, v.z
-        )
-        .with_context(|| format!("cannot write {}", path.display()))?;
+        line.clear();
+        push_imu_line(&mut line, &s, b' ', ImuDigits::Significant(digits));
+        line.push(b'\n');
+        w.write_all(&line)
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     w.flush()
         .with_context(|| format!("cannot write {}", path.display()))
@@ -374,6 +410,32 @@ mod tests {
         assert_eq!(fixed(0.000123, 6), "0.000123");
         assert_eq!(fixed(1e300, 3), format!("{:.3}", 1e300));
         assert_eq!(fixed(f64::NAN, 3), "NaN");
+    }
+
+    /// The two IMU line forms: shortest round trip, and fixed significant digits
+    /// (what `{:.9}` and `{:.12e}` print).
+    #[test]
+    fn imu_lines() {
+        let s = ImuSample {
+            t: 0.1 + 0.2,
+            dt: 0.005,
+            dtheta: Vector3::new(1e-5, -2.5e-4, 0.0),
+            dvel: Vector3::new(0.049, -1.0 / 3.0, 1e-300),
+        };
+        let line = |sep, digits| {
+            let mut out = Vec::new();
+            push_imu_line(&mut out, &s, sep, digits);
+            String::from_utf8(out).expect("ascii")
+        };
+        assert_eq!(
+            line(b',', ImuDigits::Shortest),
+            "0.30000000000000004,0.00001,-0.00025,0.0,0.049,-0.3333333333333333,1e-300"
+        );
+        assert_eq!(
+            line(b' ', ImuDigits::Significant(13)),
+            "0.300000000 1.000000000000e-5 -2.500000000000e-4 0.000000000000e0 \
+             4.900000000000e-2 -3.333333333333e-1 1.000000000000e-300"
+        );
     }
 
     #[test]

@@ -81,6 +81,19 @@ pub trait EarthModel: Copy + std::fmt::Debug + Send + Sync {
         }
     }
 
+    /// [`EarthModel::local`] from `sin lat`, `cos lat` (`cos ≥ 0`) and height `h` [m],
+    /// for callers that hold the sine and cosine rather than the latitude: the wander
+    /// mechanization (from the polar axis in its frame, seed 003) and the simulator.
+    ///
+    /// The provided method goes through `atan2` and [`EarthModel::local`], valid for
+    /// any model; [`Wgs84`] and [`Sphere`] override it with their closed forms in
+    /// `sin lat`, `cos lat` (the detour through `atan2` and back cost the wander
+    /// mechanization a fifth of a step: 1.21x NED's step time with it).
+    #[inline]
+    fn local_from_sin_cos(&self, sin_lat: f64, cos_lat: f64, h: f64) -> LocalEarth {
+        self.local(sin_lat.atan2(cos_lat), h)
+    }
+
     /// Earth rate in NED at latitude `lat`: `w_ie_n = [W cos lat, 0, -W sin lat]`.
     #[inline]
     fn w_ie_n(&self, lat: f64) -> Vector3<f64> {
@@ -222,8 +235,14 @@ impl Wgs84 {
     /// ellipsoid (< 1e-6 rad below 10 km) is neglected, as in KF-GINS and pyins.
     pub fn normal_gravity(lat: f64, h: f64) -> f64 {
         let s2 = lat.sin().powi(2);
-        let gamma = Self::GAMMA_E * (1.0 + Self::K * s2) / (1.0 - Self::E2 * s2).sqrt();
-        gamma * Self::height_factor(s2, h)
+        Self::somigliana(s2, (1.0 - Self::E2 * s2).sqrt(), h)
+    }
+
+    /// [`Wgs84::normal_gravity`] from `sin^2 lat` and `w = sqrt(1 - e^2 sin^2 lat)`:
+    /// `gamma_e (1 + k sin^2 lat) / w` (eq. 4-1) times the height factor (eq. 4-3).
+    #[inline]
+    fn somigliana(sin2_lat: f64, w: f64, h: f64) -> f64 {
+        Self::GAMMA_E * (1.0 + Self::K * sin2_lat) / w * Self::height_factor(sin2_lat, h)
     }
 
     /// TR8350.2 eq. 4-3: `gamma_h / gamma = 1 - 2/a (1 + f + m - 2 f sin^2 lat) h + 3 h^2/a^2`.
@@ -249,15 +268,19 @@ impl EarthModel for Wgs84 {
     fn gravity_n(&self, lat: f64, h: f64) -> Vector3<f64> {
         Vector3::new(0.0, 0.0, Self::normal_gravity(lat, h))
     }
-    /// As the provided method, sharing `sqrt(1 - e^2 sin^2 lat)` between the radii and
-    /// Somigliana's formula.
+    /// As the provided method, through [`EarthModel::local_from_sin_cos`].
     #[inline]
     fn local(&self, lat: f64, h: f64) -> LocalEarth {
         let (s, c) = lat.sin_cos();
+        self.local_from_sin_cos(s, c, h)
+    }
+    /// Radii ([`radii_from_sin`]) and Somigliana's normal gravity in `sin lat`,
+    /// sharing one square root.
+    #[inline]
+    fn local_from_sin_cos(&self, s: f64, c: f64, h: f64) -> LocalEarth {
         let s2 = s * s;
         let w2 = 1.0 - Self::E2 * s2;
         let w = w2.sqrt();
-        let gamma = Self::GAMMA_E * (1.0 + Self::K * s2) / w;
         LocalEarth {
             sin_lat: s,
             cos_lat: c,
@@ -266,7 +289,7 @@ impl EarthModel for Wgs84 {
                 meridian: Self::A * (1.0 - Self::E2) / (w2 * w),
                 prime_vertical: Self::A / w,
             },
-            g_n: Vector3::new(0.0, 0.0, gamma * Self::height_factor(s2, h)),
+            g_n: Vector3::new(0.0, 0.0, Self::somigliana(s2, w, h)),
             rotation_rate: Self::OMEGA,
         }
     }
@@ -313,6 +336,14 @@ impl Sphere {
         self.mu / (r * r)
     }
 
+    /// Gravity in NED from `sin lat`, `cos lat` and height (see `gravity_n`).
+    #[inline]
+    fn gravity_sin_cos(&self, s: f64, c: f64, h: f64) -> Vector3<f64> {
+        let r = self.radius + h;
+        let w2r = self.rotation_rate * self.rotation_rate * r;
+        Vector3::new(-w2r * s * c, 0.0, self.gravitation(r) - w2r * c * c)
+    }
+
     /// Schuler angular frequency at the surface, `w0 = sqrt(g / a)` [rad/s].
     pub fn schuler_frequency(&self) -> f64 {
         (self.gravitation(self.radius) / self.radius).sqrt()
@@ -333,10 +364,23 @@ impl EarthModel for Sphere {
     /// `[-W^2 r sin(lat) cos(lat), 0, mu/r^2 - W^2 r cos^2(lat)]`.
     #[inline]
     fn gravity_n(&self, lat: f64, h: f64) -> Vector3<f64> {
-        let r = self.radius + h;
         let (s, c) = lat.sin_cos();
-        let w2r = self.rotation_rate * self.rotation_rate * r;
-        Vector3::new(-w2r * s * c, 0.0, self.gravitation(r) - w2r * c * c)
+        self.gravity_sin_cos(s, c, h)
+    }
+    /// Radius `a` both ways; gravity as `gravity_n`.
+    #[inline]
+    fn local_from_sin_cos(&self, s: f64, c: f64, h: f64) -> LocalEarth {
+        LocalEarth {
+            sin_lat: s,
+            cos_lat: c,
+            h,
+            radii: Radii {
+                meridian: self.radius,
+                prime_vertical: self.radius,
+            },
+            g_n: self.gravity_sin_cos(s, c, h),
+            rotation_rate: self.rotation_rate,
+        }
     }
 }
 
@@ -367,6 +411,67 @@ mod tests {
             9.806_197_769_373,
             epsilon = 1e-12
         );
+    }
+
+    /// The closed forms of `local_from_sin_cos` agree with the generic route through
+    /// `atan2` and `gravity_n` (poles and equator included) for both models, and so does
+    /// the provided method.
+    #[test]
+    fn local_from_sin_cos_matches_local() {
+        #[derive(Debug, Clone, Copy)]
+        struct Generic(Wgs84);
+        impl EarthModel for Generic {
+            fn semi_major_axis(&self) -> f64 {
+                self.0.semi_major_axis()
+            }
+            fn eccentricity_squared(&self) -> f64 {
+                self.0.eccentricity_squared()
+            }
+            fn rotation_rate(&self) -> f64 {
+                self.0.rotation_rate()
+            }
+            fn gravity_n(&self, lat: f64, h: f64) -> Vector3<f64> {
+                self.0.gravity_n(lat, h)
+            }
+        }
+        fn check<E: EarthModel>(e: &E) {
+            for &(lat, h) in &[
+                (0.0, 0.0),
+                (0.5, 1200.0),
+                (-1.3, -80.0),
+                (FRAC_PI_2, 3000.0),
+                (-FRAC_PI_2, 0.0),
+            ] {
+                let (s, c) = lat.sin_cos();
+                let ours = e.local_from_sin_cos(s, c.abs(), h);
+                // The generic route: radii from sin lat, gravity from gravity_n.
+                let theirs = LocalEarth {
+                    sin_lat: s,
+                    cos_lat: c,
+                    h,
+                    radii: e.radii(lat),
+                    g_n: e.gravity_n(lat, h),
+                    rotation_rate: e.rotation_rate(),
+                };
+                assert_relative_eq!(ours.sin_lat, theirs.sin_lat, epsilon = 1e-15);
+                assert_relative_eq!(ours.cos_lat, theirs.cos_lat, epsilon = 1e-15);
+                assert_relative_eq!(
+                    ours.radii.meridian,
+                    theirs.radii.meridian,
+                    max_relative = 1e-15
+                );
+                assert_relative_eq!(
+                    ours.radii.prime_vertical,
+                    theirs.radii.prime_vertical,
+                    max_relative = 1e-15
+                );
+                assert_relative_eq!(ours.g_n, theirs.g_n, epsilon = 1e-14);
+                assert_eq!(ours.rotation_rate, theirs.rotation_rate);
+            }
+        }
+        check(&Wgs84);
+        check(&Sphere::textbook(true));
+        check(&Generic(Wgs84));
     }
 
     /// Free-air gradient: about -3.086e-6 s^-2 at mid latitudes (textbook value,

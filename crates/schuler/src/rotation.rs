@@ -106,6 +106,20 @@ impl Euler {
     }
 }
 
+/// Angle [rad] wrapped to (−π, π]; unchanged, bit for bit, when already inside (so
+/// wrapping twice changes nothing, and in-range angles keep every digit).
+#[inline]
+pub fn wrap_pi(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    if x > -PI && x <= PI {
+        return x;
+    }
+    // (x + π) mod 2π is in [0, 2π] (rem_euclid may round up to 2π), so w is in
+    // [−π, π]; −π itself maps to π.
+    let w = (x + PI).rem_euclid(TAU) - PI;
+    if w <= -PI { w + TAU } else { w }
+}
+
 /// Skew-symmetric (cross-product) matrix: `skew(a) * b == a.cross(&b)`.
 #[inline]
 pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
@@ -167,10 +181,33 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use proptest::prelude::*;
-    use std::f64::consts::{FRAC_PI_2, PI};
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
     fn angle_between(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
         a.angle_to(b)
+    }
+
+    /// `wrap_pi`: in-range angles unchanged to the bit, −π and odd multiples of π to
+    /// +π, whole turns removed.
+    #[test]
+    fn wrap_pi_examples() {
+        for x in [0.0, -0.0, 1.0, -3.0, PI, -PI + 1e-15, 3.1] {
+            assert_eq!(wrap_pi(x).to_bits(), x.to_bits(), "{x}");
+        }
+        assert_eq!(wrap_pi(-PI), PI);
+        assert_eq!(wrap_pi(3.0 * PI), PI);
+        assert_eq!(wrap_pi(-3.0 * PI), PI);
+        assert_relative_eq!(
+            wrap_pi(190f64.to_radians()),
+            -170f64.to_radians(),
+            epsilon = 1e-14
+        );
+        assert_relative_eq!(
+            wrap_pi(-190f64.to_radians()),
+            170f64.to_radians(),
+            epsilon = 1e-14
+        );
+        assert_relative_eq!(wrap_pi(1.0 + 10.0 * TAU), 1.0, epsilon = 1e-13);
     }
 
     /// Frame direction check with an independent construction: yaw 90 deg turns the

@@ -1,7 +1,9 @@
 //! Engineering units <-> SI: parse and print the units used in navigation.
 //!
 //! Inside the library every quantity is SI with radians: rad, rad/s, rad/sqrt(s) (angle
-//! random walk), m/s/sqrt(s) (velocity random walk), m/s^2, a plain ratio, s, m, m/s.
+//! random walk), m/s/sqrt(s) (velocity random walk), rad/s/sqrt(s) (rate random walk),
+//! m/s^2/sqrt(s) (acceleration random walk), rad/s/(m/s^2) (gyro g-sensitivity), m/s^2,
+//! a plain ratio, s, m, m/s.
 //! This module is the edge: configs, file headers and reports write `"0.01 deg/h"`,
 //! `"25 ug"`, `"20 arcsec"`, `"100 ppm"`, `"0.003 deg/sqrt(h)"`, `"15 mGal"` or
 //! `"1 nmi/h"`, and [`parse_as`] turns them into SI `f64`s while [`format()`] prints SI
@@ -59,6 +61,10 @@ pub const DEG_PER_SQRT_H: f64 = DEG / 60.0;
 pub const DEG_PER_H_PER_SQRT_HZ: f64 = DEG_PER_H;
 /// One m/s/sqrt(h) of velocity random walk in m/s/sqrt(s): 1/60.
 pub const M_PER_S_PER_SQRT_H: f64 = 1.0 / 60.0;
+/// One deg/h/sqrt(h) of rate random walk in rad/s/sqrt(s): DEG / (3600 * 60).
+pub const DEG_PER_H_PER_SQRT_H: f64 = DEG / (HOUR * 60.0);
+/// One deg/h per g of gyro g-sensitivity in rad/s per m/s^2: DEG / 3600 / G0.
+pub const DEG_PER_H_PER_G: f64 = DEG / (HOUR * G0);
 /// One milli-g in m/s^2 (1e-3 G0); spelled `mg`, not to be confused with [`MGAL`].
 pub const MG: f64 = G0 / 1e3;
 /// One micro-g in m/s^2 (1e-6 G0); also the SI value of 1 ug/sqrt(Hz) in m/s/sqrt(s).
@@ -99,6 +105,13 @@ pub enum Dimension {
     AngleRandomWalk,
     /// Velocity random walk (accelerometer white noise density), SI m/s/sqrt(s).
     VelocityRandomWalk,
+    /// Rate random walk (random walk of a gyro bias), SI rad/s/sqrt(s).
+    RateRandomWalk,
+    /// Acceleration random walk (random walk of an accelerometer bias), SI
+    /// m/s^2/sqrt(s).
+    AccelerationRandomWalk,
+    /// Gyro g-sensitivity (rate error per specific force), SI rad/s per m/s^2.
+    GSensitivity,
     /// Acceleration (specific force, gravity), SI m/s^2.
     Acceleration,
     /// Dimensionless ratio (scale factor, ppm, percent), SI 1.
@@ -113,11 +126,14 @@ pub enum Dimension {
 
 impl Dimension {
     /// Every dimension, in declaration order.
-    pub const ALL: [Dimension; 9] = [
+    pub const ALL: [Dimension; 12] = [
         Dimension::Angle,
         Dimension::AngularRate,
         Dimension::AngleRandomWalk,
         Dimension::VelocityRandomWalk,
+        Dimension::RateRandomWalk,
+        Dimension::AccelerationRandomWalk,
+        Dimension::GSensitivity,
         Dimension::Acceleration,
         Dimension::Dimensionless,
         Dimension::Time,
@@ -132,6 +148,9 @@ impl Dimension {
             Dimension::AngularRate => "rad/s",
             Dimension::AngleRandomWalk => "rad/sqrt(s)",
             Dimension::VelocityRandomWalk => "m/s/sqrt(s)",
+            Dimension::RateRandomWalk => "rad/s/sqrt(s)",
+            Dimension::AccelerationRandomWalk => "m/s^2/sqrt(s)",
+            Dimension::GSensitivity => "rad/s/(m/s^2)",
             Dimension::Acceleration => "m/s^2",
             Dimension::Dimensionless => "1",
             Dimension::Time => "s",
@@ -152,6 +171,9 @@ impl Dimension {
             Dimension::AngularRate => "an angular rate",
             Dimension::AngleRandomWalk => "an angle random walk",
             Dimension::VelocityRandomWalk => "a velocity random walk",
+            Dimension::RateRandomWalk => "a rate random walk",
+            Dimension::AccelerationRandomWalk => "an acceleration random walk",
+            Dimension::GSensitivity => "a g-sensitivity (angular rate per acceleration)",
             Dimension::Acceleration => "an acceleration",
             Dimension::Dimensionless => "a dimensionless ratio",
             Dimension::Time => "a time",
@@ -274,6 +296,56 @@ static TABLE: &[Entry] = {
         entry("g/sqrt(Hz)", D::VelocityRandomWalk, (G0, 1.0), &[]),
         entry("mg/sqrt(Hz)", D::VelocityRandomWalk, (G0, 1e3), &[]),
         entry("ug/sqrt(Hz)", D::VelocityRandomWalk, (G0, 1e6), &[]),
+        // Rate random walk: deg/h/sqrt(h) = DEG / 3600 / 60 rad/s/sqrt(s)
+        entry("rad/s/sqrt(s)", D::RateRandomWalk, ONE, &[]),
+        entry("deg/s/sqrt(s)", D::RateRandomWalk, (DEG, 1.0), &[]),
+        entry(
+            "deg/h/sqrt(h)",
+            D::RateRandomWalk,
+            (DEG, HOUR * 60.0),
+            &["deg/hr/sqrt(hr)"],
+        ),
+        // Acceleration random walk
+        entry(
+            "m/s^2/sqrt(s)",
+            D::AccelerationRandomWalk,
+            ONE,
+            &["m/s2/sqrt(s)"],
+        ),
+        entry(
+            "m/s^2/sqrt(h)",
+            D::AccelerationRandomWalk,
+            (1.0, 60.0),
+            &["m/s2/sqrt(h)"],
+        ),
+        entry(
+            "m/s/h/sqrt(h)",
+            D::AccelerationRandomWalk,
+            (1.0, HOUR * 60.0),
+            &["m/s/hr/sqrt(hr)"],
+        ),
+        entry(
+            "mg/sqrt(h)",
+            D::AccelerationRandomWalk,
+            (G0, 1e3 * 60.0),
+            &["mg/sqrt(hr)"],
+        ),
+        entry(
+            "ug/sqrt(h)",
+            D::AccelerationRandomWalk,
+            (G0, 1e6 * 60.0),
+            &["ug/sqrt(hr)"],
+        ),
+        // Gyro g-sensitivity: rate per specific force
+        entry("rad/s/(m/s^2)", D::GSensitivity, ONE, &["rad/s/(m/s2)"]),
+        entry("rad/s/g", D::GSensitivity, (1.0, G0), &[]),
+        entry("deg/s/g", D::GSensitivity, (DEG, G0), &[]),
+        entry(
+            "deg/h/g",
+            D::GSensitivity,
+            (DEG, HOUR * G0),
+            &["deg/hr/g", "dph/g"],
+        ),
         // Acceleration
         entry("m/s^2", D::Acceleration, ONE, &["m/s2", "m/s/s"]),
         entry("g", D::Acceleration, (G0, 1.0), &[]),
@@ -916,6 +988,45 @@ mod tests {
             ("1 g/sqrt(Hz)", 9.80665, D::VelocityRandomWalk),
             ("1 mg/sqrt(Hz)", 9.80665e-3, D::VelocityRandomWalk),
             ("1 ug/sqrt(Hz)", 9.80665e-6, D::VelocityRandomWalk),
+            // Rate random walk
+            ("1 rad/s/sqrt(s)", 1.0, D::RateRandomWalk),
+            (
+                "1 deg/s/sqrt(s)",
+                0.017_453_292_519_943_295_77,
+                D::RateRandomWalk,
+            ),
+            (
+                "1 deg/h/sqrt(h)",
+                8.080_228_018_492_266_559_8e-8,
+                D::RateRandomWalk,
+            ),
+            // Acceleration random walk
+            ("1 m/s^2/sqrt(s)", 1.0, D::AccelerationRandomWalk),
+            (
+                "1 m/s^2/sqrt(h)",
+                0.016_666_666_666_666_666_667,
+                D::AccelerationRandomWalk,
+            ),
+            (
+                "1 m/s/h/sqrt(h)",
+                4.629_629_629_629_629_629_6e-6,
+                D::AccelerationRandomWalk,
+            ),
+            (
+                "1 mg/sqrt(h)",
+                1.634_441_666_666_666_666_7e-4,
+                D::AccelerationRandomWalk,
+            ),
+            (
+                "1 ug/sqrt(h)",
+                1.634_441_666_666_666_666_7e-7,
+                D::AccelerationRandomWalk,
+            ),
+            // Gyro g-sensitivity
+            ("1 rad/s/(m/s^2)", 1.0, D::GSensitivity),
+            ("1 rad/s/g", 0.101_971_621_297_792_824_26, D::GSensitivity),
+            ("1 deg/s/g", 1.779_740_535_243_257_969_8e-3, D::GSensitivity),
+            ("1 deg/h/g", 4.943_723_709_009_049_916e-7, D::GSensitivity),
             // Acceleration
             ("1e-3 m/s^2", 1e-3, D::Acceleration),
             ("1 g", 9.80665, D::Acceleration),
@@ -1001,6 +1112,8 @@ mod tests {
             (DEG_PER_H, 4.848_136_811_095_359_935_9e-6),
             (DEG_PER_SQRT_H, 2.908_882_086_657_215_961_5e-4),
             (M_PER_S_PER_SQRT_H, 0.016_666_666_666_666_666_667),
+            (DEG_PER_H_PER_SQRT_H, 8.080_228_018_492_266_559_8e-8),
+            (DEG_PER_H_PER_G, 4.943_723_709_009_049_916e-7),
             (MGAL, 1e-5),
             (MG, 9.80665e-3),
             (UG, 9.80665e-6),
@@ -1024,6 +1137,8 @@ mod tests {
             (DEG_PER_SQRT_H, "deg/sqrt(h)"),
             (DEG_PER_H_PER_SQRT_HZ, "deg/h/sqrt(Hz)"),
             (M_PER_S_PER_SQRT_H, "m/s/sqrt(h)"),
+            (DEG_PER_H_PER_SQRT_H, "deg/h/sqrt(h)"),
+            (DEG_PER_H_PER_G, "deg/h/g"),
             (G0, "g"),
             (MG, "mg"),
             (UG, "ug"),
@@ -1222,6 +1337,9 @@ mod tests {
                 "an angular rate",
                 "an angle random walk",
                 "a velocity random walk",
+                "a rate random walk",
+                "an acceleration random walk",
+                "a g-sensitivity (angular rate per acceleration)",
                 "an acceleration",
                 "a dimensionless ratio",
                 "a time",

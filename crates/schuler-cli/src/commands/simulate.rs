@@ -13,12 +13,13 @@
 //!
 //! The same scenario and seed give the same bytes.
 
+use crate::output::{ImuDigits, push_imu_line};
 use anyhow::{Context, Result};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::sim::analytic::Kinematics;
 use schuler::sim::receivers::{BaroReading, GnssFix};
-use schuler::sim::run::{ScenarioSpec, SimSink, simulate};
+use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, SimSink, simulate};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -49,7 +50,7 @@ impl Out {
         let path = dir.join(name);
         let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
         Ok(Self {
-            w: BufWriter::with_capacity(1 << 20, f),
+            w: BufWriter::with_capacity(1 << 16, f),
             path,
         })
     }
@@ -64,14 +65,14 @@ impl Out {
 /// Appends numbers separated by `sep` in shortest round-trip form.
 struct Line {
     buf: Vec<u8>,
-    ryu: ryu::Buffer,
+    num: zmij::Buffer,
 }
 
 impl Line {
     fn new() -> Self {
         Self {
             buf: Vec::with_capacity(512),
-            ryu: ryu::Buffer::new(),
+            num: zmij::Buffer::new(),
         }
     }
 
@@ -84,7 +85,7 @@ impl Line {
         if !self.buf.is_empty() {
             self.buf.push(sep);
         }
-        self.buf.extend_from_slice(self.ryu.format(x).as_bytes());
+        self.buf.extend_from_slice(self.num.format(x).as_bytes());
         self
     }
 
@@ -118,6 +119,62 @@ fn nav_fields(s: &NavState) -> [f64; 9] {
     ]
 }
 
+/// The text of consecutive IMU epochs for the four per-epoch files.
+///
+/// Each number is formatted once: the CSV twin of a line is the same bytes with
+/// commas for spaces (no number contains either).
+#[derive(Default)]
+struct EpochText {
+    imu_txt: Vec<u8>,
+    imu_csv: Vec<u8>,
+    truth_nav: Vec<u8>,
+    truth_csv: Vec<u8>,
+}
+
+/// `bytes` with every space turned into a comma, appended to `out`.
+fn push_as_csv(out: &mut Vec<u8>, bytes: &[u8]) {
+    out.extend(bytes.iter().map(|&b| if b == b' ' { b',' } else { b }));
+}
+
+impl EpochText {
+    fn clear(&mut self) {
+        self.imu_txt.clear();
+        self.imu_csv.clear();
+        self.truth_nav.clear();
+        self.truth_csv.clear();
+    }
+
+    /// Append the lines of `epochs`.
+    fn push(&mut self, epochs: &[ImuEpoch]) {
+        let mut num = zmij::Buffer::new();
+        for e in epochs {
+            // imu.txt (KF-GINS) and imu.csv: the measured sample.
+            let start = self.imu_txt.len();
+            push_imu_line(&mut self.imu_txt, &e.measured, b' ', ImuDigits::Shortest);
+            self.imu_txt.push(b'\n');
+            push_as_csv(&mut self.imu_csv, &self.imu_txt[start..]);
+            // truth.nav: week 0, then `t lat lon h vn ve vd roll pitch yaw`; truth.csv:
+            // the same after the week, then w_ib_b and f_b.
+            self.truth_nav.extend_from_slice(b"0 ");
+            let start = self.truth_nav.len();
+            self.truth_nav
+                .extend_from_slice(num.format(e.truth.t).as_bytes());
+            for x in nav_fields(&e.truth) {
+                self.truth_nav.push(b' ');
+                self.truth_nav.extend_from_slice(num.format(x).as_bytes());
+            }
+            push_as_csv(&mut self.truth_csv, &self.truth_nav[start..]);
+            self.truth_nav.push(b'\n');
+            let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
+            for x in [w.x, w.y, w.z, f.x, f.y, f.z] {
+                self.truth_csv.push(b',');
+                self.truth_csv.extend_from_slice(num.format(x).as_bytes());
+            }
+            self.truth_csv.push(b'\n');
+        }
+    }
+}
+
 /// Writes every stream to its files.
 struct FileSink {
     imu_txt: Out,
@@ -127,10 +184,15 @@ struct FileSink {
     gnss_txt: Option<(Out, Out)>,
     baro_csv: Option<Out>,
     line: Line,
+    /// Text buffers, one per formatting thread (reused from block to block).
+    text: Vec<EpochText>,
 }
 
 impl FileSink {
     fn create(dir: &Path, gnss: bool, baro: bool) -> Result<Self> {
+        let threads = std::thread::available_parallelism()
+            .map_or(1, usize::from)
+            .clamp(1, 8);
         let mut s = Self {
             imu_txt: Out::create(dir, "imu.txt")?,
             imu_csv: Out::create(dir, "imu.csv")?,
@@ -147,6 +209,7 @@ impl FileSink {
                 None
             },
             line: Line::new(),
+            text: (0..threads).map(|_| EpochText::default()).collect(),
         };
         let header = |o: &mut Out, h: &str| {
             writeln!(o.w, "{h}").with_context(|| format!("cannot write {}", o.path.display()))
@@ -171,6 +234,17 @@ impl FileSink {
         Ok(s)
     }
 
+    /// Write the formatted text of the first `parts` buffers, in order.
+    fn write_text(&mut self, parts: usize) -> std::io::Result<()> {
+        for t in &self.text[..parts] {
+            self.imu_txt.w.write_all(&t.imu_txt)?;
+            self.imu_csv.w.write_all(&t.imu_csv)?;
+            self.truth_nav.w.write_all(&t.truth_nav)?;
+            self.truth_csv.w.write_all(&t.truth_csv)?;
+        }
+        Ok(())
+    }
+
     fn finish(self) -> Result<()> {
         self.imu_txt.finish()?;
         self.imu_csv.finish()?;
@@ -190,39 +264,50 @@ impl FileSink {
 impl SimSink for FileSink {
     fn imu(
         &mut self,
-        _exact: &ImuSample,
-        m: &ImuSample,
+        exact: &ImuSample,
+        measured: &ImuSample,
         truth: &NavState,
         kin: &Kinematics,
     ) -> std::io::Result<()> {
-        let inc = [
-            m.dtheta.x, m.dtheta.y, m.dtheta.z, m.dvel.x, m.dvel.y, m.dvel.z,
-        ];
-        self.line
-            .start()
-            .num(m.t, b' ')
-            .nums(&inc, b' ')
-            .write(&mut self.imu_txt)?;
-        self.line
-            .start()
-            .num(m.t, b',')
-            .nums(&inc, b',')
-            .write(&mut self.imu_csv)?;
-        let nav = nav_fields(truth);
-        self.line
-            .start()
-            .num(0.0, b' ')
-            .num(truth.t, b' ')
-            .nums(&nav, b' ')
-            .write(&mut self.truth_nav)?;
-        let w = kin.w_ib_b;
-        let f = kin.f_b;
-        self.line
-            .start()
-            .num(truth.t, b',')
-            .nums(&nav, b',')
-            .nums(&[w.x, w.y, w.z, f.x, f.y, f.z], b',')
-            .write(&mut self.truth_csv)
+        self.text[0].clear();
+        self.text[0].push(&[ImuEpoch {
+            exact: *exact,
+            measured: *measured,
+            truth: *truth,
+            kin: *kin,
+        }]);
+        self.write_text(1)
+    }
+
+    /// The GNSS and barometer epochs (a few) as they come; the IMU epochs formatted
+    /// in parallel chunks, then written in order: the same bytes as one at a time.
+    fn block(&mut self, block: &SimBlock) -> std::io::Result<()> {
+        for (_, fix) in &block.gnss {
+            self.gnss(fix)?;
+        }
+        for (_, r) in &block.baro {
+            self.baro(r)?;
+        }
+        let chunk = block.imu.len().div_ceil(self.text.len()).max(1);
+        let mut parts = 0;
+        std::thread::scope(|scope| {
+            let mut jobs = block.imu.chunks(chunk).zip(self.text.iter_mut());
+            // The first chunk on this thread, the others on their own.
+            let first = jobs.next();
+            for (epochs, text) in jobs {
+                parts += 1;
+                scope.spawn(move || {
+                    text.clear();
+                    text.push(epochs);
+                });
+            }
+            if let Some((epochs, text)) = first {
+                parts += 1;
+                text.clear();
+                text.push(epochs);
+            }
+        });
+        self.write_text(parts)
     }
 
     fn gnss(&mut self, fix: &GnssFix) -> std::io::Result<()> {

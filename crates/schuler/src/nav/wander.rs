@@ -42,7 +42,7 @@
 //!
 //! 1. Middle of the interval, extrapolated: `v_mid = v_{k-1} + ½ dt/dt_{k-1} Δv_{k-1}`,
 //!    `h_mid = h − ½ v_z dt`, `u_mid = u + ½ dt u × ρ(v_mid)` (`u̇ = u × ρ`); one Earth
-//!    model evaluation there, from `sin lat` ([`WanderEarth`]) extrapolated from the
+//!    model evaluation there, from `sin lat` ([`EarthModel::local_from_sin_cos`]) extrapolated from the
 //!    last two middles (as NED extrapolates its middle latitude).
 //! 2. Velocity (seed eq. (2) in increment form): `ζ = (Ω u + ρ) dt`,
 //!    `v_k = v_{k-1} + (I − ½ζ×) C_bw dv_f^b + (g^w − (2Ω u + ρ) × v_mid) dt`.
@@ -88,10 +88,11 @@ use super::strapdown::{
     update_attitude,
 };
 use super::{Corrections, LocalLevel, Mechanization, NavState};
-use crate::earth::{EarthModel, Geodetic, LocalEarth, Radii, Sphere, Wgs84};
+use crate::earth::{EarthModel, Geodetic, LocalEarth};
 use crate::imu::ImuSample;
+use crate::rotation::wrap_pi;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::FRAC_PI_2;
 
 /// Within this `cos(lat)` of a pole (6.4e-8 m from the polar axis) longitude is
 /// reported as the pole longitude (see the module doc).
@@ -105,15 +106,6 @@ pub fn q_we_from_geodetic(lat: f64, lon: f64, alpha: f64) -> UnitQuaternion<f64>
     UnitQuaternion::from_axis_angle(&z, lon)
         * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -lat - FRAC_PI_2)
         * UnitQuaternion::from_axis_angle(&z, alpha)
-}
-
-/// Angle wrapped to (−π, π] (unchanged, bit for bit, when already inside).
-fn wrap_pi(x: f64) -> f64 {
-    if x > -PI && x <= PI {
-        return x;
-    }
-    let w = (x + PI).rem_euclid(2.0 * PI) - PI;
-    if w <= -PI { w + 2.0 * PI } else { w }
 }
 
 /// Latitude, longitude [rad] and wander azimuth `α` [rad] of `q_we` (seed 003's
@@ -290,75 +282,13 @@ fn gravity_w(g_n: &Vector3<f64>, u_w: &Vector3<f64>) -> Vector3<f64> {
     }
 }
 
-/// The Earth-model evaluation the wander mechanization needs once per step, taken
-/// from the polar axis in the wander frame `u^w` (`sin lat = −u_z`,
-/// `cos lat = |u_xy|`) rather than from a latitude: the state holds sine and
-/// cosine, and the detour through `atan2` and back through `sin` cost a fifth of a
-/// step (measured with it: 1.21x NED's step time).
+/// The Earth models the wander mechanization runs on: every [`EarthModel`].
 ///
-/// The provided method is that detour and is valid for any [`EarthModel`]
-/// (`impl WanderEarth for MyModel {}`); [`Wgs84`] and [`Sphere`] override it with
-/// their closed forms in `sin lat`, `cos lat`, tested against [`EarthModel::local`].
-/// It belongs in [`EarthModel`] as a provided method (`local_from_sin_cos`); then this
-/// trait and its bound go away.
-pub trait WanderEarth: EarthModel {
-    /// The local Earth (radii, gravity in NED) at `sin lat`, `cos lat` (`cos ≥ 0`)
-    /// and height `h` [m].
-    #[inline]
-    fn local_from_sin_cos(&self, sin_lat: f64, cos_lat: f64, h: f64) -> LocalEarth {
-        self.local(sin_lat.atan2(cos_lat), h)
-    }
-}
+/// Kept so that existing `E: WanderEarth` bounds compile; the per-step evaluation it
+/// used to add, [`EarthModel::local_from_sin_cos`], is now part of [`EarthModel`].
+pub trait WanderEarth: EarthModel {}
 
-impl WanderEarth for Wgs84 {
-    /// [`Wgs84::local`] in terms of `sin lat`: radii and Somigliana's normal gravity
-    /// with the TR8350.2 eq. 4-3 height series, one square root and one division.
-    #[inline]
-    fn local_from_sin_cos(&self, s: f64, c: f64, h: f64) -> LocalEarth {
-        const A: f64 = Wgs84::A;
-        const TWO_OVER_A: f64 = 2.0 / Wgs84::A;
-        const THREE_OVER_A2: f64 = 3.0 / (Wgs84::A * Wgs84::A);
-        let s2 = s * s;
-        let w2 = 1.0 - Wgs84::E2 * s2;
-        let inv_w = 1.0 / w2.sqrt();
-        let gamma = Wgs84::GAMMA_E * (1.0 + Wgs84::K * s2) * inv_w;
-        let height_factor = 1.0
-            - TWO_OVER_A * (1.0 + Wgs84::F + Wgs84::M - 2.0 * Wgs84::F * s2) * h
-            + THREE_OVER_A2 * h * h;
-        LocalEarth {
-            sin_lat: s,
-            cos_lat: c,
-            h,
-            radii: Radii {
-                meridian: A * (1.0 - Wgs84::E2) * inv_w * inv_w * inv_w,
-                prime_vertical: A * inv_w,
-            },
-            g_n: Vector3::new(0.0, 0.0, gamma * height_factor),
-            rotation_rate: Wgs84::OMEGA,
-        }
-    }
-}
-
-impl WanderEarth for Sphere {
-    /// Radius `a` both ways; central gravitation plus the centrifugal term in NED,
-    /// `[−W² r sin cos, 0, mu/r² − W² r cos²]` (as [`Sphere`]'s `gravity_n`).
-    #[inline]
-    fn local_from_sin_cos(&self, s: f64, c: f64, h: f64) -> LocalEarth {
-        let r = self.radius + h;
-        let w2r = self.rotation_rate * self.rotation_rate * r;
-        LocalEarth {
-            sin_lat: s,
-            cos_lat: c,
-            h,
-            radii: Radii {
-                meridian: self.radius,
-                prime_vertical: self.radius,
-            },
-            g_n: Vector3::new(-w2r * s * c, 0.0, self.gravitation(r) - w2r * c * c),
-            rotation_rate: self.rotation_rate,
-        }
-    }
-}
+impl<E: EarthModel> WanderEarth for E {}
 
 /// The wander mechanization's state at one time: non-singular everywhere.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -763,59 +693,6 @@ mod tests {
         );
         assert!(accurate.angle_to(&exact) < 5e-16);
         assert!((hi.norm() - 1.0).abs() < 1e-15);
-    }
-
-    /// The closed forms of `WanderEarth` agree with `EarthModel::local` (poles and
-    /// equator included) for both models, and so does the provided method.
-    #[test]
-    fn wander_earth_matches_local() {
-        #[derive(Debug, Clone, Copy)]
-        struct Generic(Wgs84);
-        impl EarthModel for Generic {
-            fn semi_major_axis(&self) -> f64 {
-                self.0.semi_major_axis()
-            }
-            fn eccentricity_squared(&self) -> f64 {
-                self.0.eccentricity_squared()
-            }
-            fn rotation_rate(&self) -> f64 {
-                self.0.rotation_rate()
-            }
-            fn gravity_n(&self, lat: f64, h: f64) -> Vector3<f64> {
-                self.0.gravity_n(lat, h)
-            }
-        }
-        impl WanderEarth for Generic {}
-        fn check<E: WanderEarth>(e: &E) {
-            for &(lat, h) in &[
-                (0.0, 0.0),
-                (0.5, 1200.0),
-                (-1.3, -80.0),
-                (FRAC_PI_2, 3000.0),
-                (-FRAC_PI_2, 0.0),
-            ] {
-                let u = polar_axis_w(&q_we_from_geodetic(lat, 0.4, 1.0));
-                let ours = e.local_from_sin_cos(-u.z, u.xy().norm(), h);
-                let theirs = e.local(lat, h);
-                assert_relative_eq!(ours.sin_lat, theirs.sin_lat, epsilon = 1e-15);
-                assert_relative_eq!(ours.cos_lat, theirs.cos_lat, epsilon = 1e-15);
-                assert_relative_eq!(
-                    ours.radii.meridian,
-                    theirs.radii.meridian,
-                    max_relative = 1e-15
-                );
-                assert_relative_eq!(
-                    ours.radii.prime_vertical,
-                    theirs.radii.prime_vertical,
-                    max_relative = 1e-15
-                );
-                assert_relative_eq!(ours.g_n, theirs.g_n, epsilon = 1e-14);
-                assert_eq!(ours.rotation_rate, theirs.rotation_rate);
-            }
-        }
-        check(&Wgs84);
-        check(&Sphere::textbook(true));
-        check(&Generic(Wgs84));
     }
 
     /// Gravity turned from NED on the rotating sphere (north component non-zero).

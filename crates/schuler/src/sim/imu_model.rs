@@ -78,6 +78,7 @@ struct TriadState {
     gm: Vector3<f64>,
     rw: Vector3<f64>,
     carry: Vector3<f64>,
+    step: Option<Step>,
 }
 
 /// A seeded simulation of an [`ImuModel`], applied sample after sample.
@@ -92,8 +93,44 @@ pub struct ImuSimulator {
 /// Stream ids of the random draws, fixed so adding a term never reshuffles another.
 const STREAM_IMU: u64 = 1;
 
+/// Three standard normals (ziggurat: the IMU draws nine pairs per sample).
 fn draw3(noise: &mut Noise) -> Vector3<f64> {
-    Vector3::new(noise.normal(), noise.normal(), noise.normal())
+    Vector3::new(
+        noise.normal_ziggurat(),
+        noise.normal_ziggurat(),
+        noise.normal_ziggurat(),
+    )
+}
+
+/// Per-interval constants of one triad's processes for one `dt` (computed once: the
+/// exponential and square roots cost more than the rest of a sample).
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    dt: f64,
+    sqrt_dt: f64,
+    /// Gauss–Markov `e^{-dt/τ}` (0 where the process is off).
+    gm_phi: Vector3<f64>,
+    /// Gauss–Markov innovation std `σ sqrt(1 - e^{-2dt/τ})`.
+    gm_q: Vector3<f64>,
+}
+
+impl Step {
+    fn new(m: &TriadModel, dt: f64) -> Self {
+        let (mut gm_phi, mut gm_q) = (Vector3::zeros(), Vector3::zeros());
+        for i in 0..3 {
+            if m.gm_sigma[i] > 0.0 && m.gm_tau[i] > 0.0 {
+                let phi = (-dt / m.gm_tau[i]).exp();
+                gm_phi[i] = phi;
+                gm_q[i] = m.gm_sigma[i] * (1.0 - phi * phi).sqrt();
+            }
+        }
+        Self {
+            dt,
+            sqrt_dt: dt.sqrt(),
+            gm_phi,
+            gm_q,
+        }
+    }
 }
 
 impl TriadState {
@@ -106,6 +143,7 @@ impl TriadState {
             gm,
             rw: Vector3::zeros(),
             carry: Vector3::zeros(),
+            step: None,
         }
     }
 
@@ -122,13 +160,16 @@ impl TriadState {
         let w_gm = draw3(noise);
         let w_rw = draw3(noise);
         let w_white = draw3(noise);
+        let step = match self.step {
+            Some(st) if st.dt == dt => st,
+            _ => *self.step.insert(Step::new(m, dt)),
+        };
         let mut y = Vector3::zeros();
         for i in 0..3 {
             if m.gm_sigma[i] > 0.0 && m.gm_tau[i] > 0.0 {
-                let phi = (-dt / m.gm_tau[i]).exp();
-                self.gm[i] = phi * self.gm[i] + m.gm_sigma[i] * (1.0 - phi * phi).sqrt() * w_gm[i];
+                self.gm[i] = step.gm_phi[i] * self.gm[i] + step.gm_q[i] * w_gm[i];
             }
-            self.rw[i] += m.random_walk[i] * dt.sqrt() * w_rw[i];
+            self.rw[i] += m.random_walk[i] * step.sqrt_dt * w_rw[i];
             let gain = 1.0 + m.scale[i] + m.asymmetry[i] * x[i].signum();
             let mut cross = 0.0;
             for j in 0..3 {
@@ -137,7 +178,7 @@ impl TriadState {
                 }
             }
             let bias = m.bias[i] + self.turn_on[i] + self.gm[i] + self.rw[i];
-            y[i] = gain * x[i] + cross + bias * dt + m.white[i] * dt.sqrt() * w_white[i];
+            y[i] = gain * x[i] + cross + bias * dt + m.white[i] * step.sqrt_dt * w_white[i];
         }
         y
     }

@@ -56,6 +56,13 @@ impl Jet {
         self.chain(c, -s, -c)
     }
 
+    /// Sine and cosine from one `sin_cos` of the value.
+    #[inline]
+    pub fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c, -s), self.chain(c, -s, -c))
+    }
+
     /// Square root (of a positive value).
     pub fn sqrt(self) -> Self {
         let r = self.v.sqrt();
@@ -233,9 +240,9 @@ impl JetMat3 {
 
     /// `c_bn = Rz(yaw) Ry(pitch) Rx(roll)` with jets (see [`crate::rotation::Euler`]).
     pub fn from_euler(roll: Jet, pitch: Jet, yaw: Jet) -> Self {
-        let (sr, cr) = (roll.sin(), roll.cos());
-        let (sp, cp) = (pitch.sin(), pitch.cos());
-        let (sy, cy) = (yaw.sin(), yaw.cos());
+        let (sr, cr) = roll.sin_cos();
+        let (sp, cp) = pitch.sin_cos();
+        let (sy, cy) = yaw.sin_cos();
         Self([
             [cp * cy, -(cr * sy) + sr * sp * cy, sr * sy + cr * sp * cy],
             [cp * sy, cr * cy + sr * sp * sy, -(sr * cy) + cr * sp * sy],

@@ -54,6 +54,70 @@ impl Noise {
     }
 }
 
+/// Layers of the ziggurat ([`Noise::normal_ziggurat`]).
+const ZIG_LAYERS: usize = 256;
+/// Right edge of the base layer (Marsaglia & Tsang 2000, 256 layers).
+const ZIG_R: f64 = 3.654_152_885_361_009;
+/// Area of each layer, base layer's tail included (Marsaglia & Tsang 2000).
+const ZIG_V: f64 = 4.928_673_233_99e-3;
+
+/// The ziggurat's layer edges `x[0..=256]` for the density `f(x) = exp(-x²/2)`:
+/// `x[0] = V/f(r)` (the base layer as a rectangle of area V), `x[1] = r`,
+/// `x[i+1] = f⁻¹(V/x[i] + f(x[i]))`, `x[256] = 0`.
+fn ziggurat_edges() -> &'static [f64; ZIG_LAYERS + 1] {
+    static EDGES: std::sync::OnceLock<[f64; ZIG_LAYERS + 1]> = std::sync::OnceLock::new();
+    EDGES.get_or_init(|| {
+        let f = |x: f64| (-0.5 * x * x).exp();
+        let mut x = [0.0; ZIG_LAYERS + 1];
+        x[0] = ZIG_V / f(ZIG_R);
+        x[1] = ZIG_R;
+        for i in 1..ZIG_LAYERS - 1 {
+            x[i + 1] = (-2.0 * (ZIG_V / x[i] + f(x[i])).ln()).sqrt();
+        }
+        x[ZIG_LAYERS] = 0.0;
+        x
+    })
+}
+
+impl Noise {
+    /// Standard normal by the ziggurat method (Marsaglia & Tsang 2000, 256 layers, in
+    /// Doornik's 2005 form with a signed uniform): one 64-bit draw per variate for 99 %
+    /// of them (8 bits pick the layer, 53 others the abscissa), no logarithm or
+    /// trigonometry; the rare wedge and tail cases draw more. Several times faster than
+    /// [`Noise::normal`], for the per-sample sensor noise; another sequence of variates
+    /// from the same stream.
+    pub fn normal_ziggurat(&mut self) -> f64 {
+        let x = ziggurat_edges();
+        loop {
+            let bits: u64 = self.rng.random();
+            let i = (bits & 0xff) as usize;
+            // Signed uniform in (-1, 1) from the top 53 bits, never 0.
+            let u = ((bits >> 11) as f64 + 0.5) * (2.0 / (1u64 << 53) as f64) - 1.0;
+            let z = u * x[i];
+            if z.abs() < x[i + 1] {
+                return z;
+            }
+            if i == 0 {
+                // The tail beyond r (Marsaglia 1964): x = -ln(U1)/r, y = -ln(U2),
+                // accepted when 2y > x².
+                loop {
+                    let t = -self.uniform().ln() / ZIG_R;
+                    let y = -self.uniform().ln();
+                    if 2.0 * y > t * t {
+                        return if u < 0.0 { -(ZIG_R + t) } else { ZIG_R + t };
+                    }
+                }
+            }
+            // Wedge between the layer's rectangle and the density.
+            let f0 = (-0.5 * (x[i] * x[i] - z * z)).exp();
+            let f1 = (-0.5 * (x[i + 1] * x[i + 1] - z * z)).exp();
+            if f1 + self.uniform() * (f0 - f1) < 1.0 {
+                return z;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,6 +154,65 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    /// The ziggurat's layers: each has area V, the base one (rectangle r f(r) plus the
+    /// tail beyond r) too, and the top one closes at the mode: x[255] (1 - f(x[255]))
+    /// = V to 1e-9 relative, the precision of the published V (12 digits).
+    #[test]
+    fn ziggurat_layers_have_equal_areas() {
+        let x = ziggurat_edges();
+        let f = |x: f64| (-0.5 * x * x).exp();
+        for i in 1..ZIG_LAYERS - 1 {
+            let area = x[i] * (f(x[i + 1]) - f(x[i]));
+            assert!((area - ZIG_V).abs() < 1e-15, "layer {i}: {area}");
+        }
+        let top = x[ZIG_LAYERS - 1] * (1.0 - f(x[ZIG_LAYERS - 1]));
+        assert!((top - ZIG_V).abs() < 2e-9 * ZIG_V, "top layer {top}");
+        // The tail integral by Simpson's rule on [r, r + 10] (f(r + 10) ~ 1e-37).
+        let (n, h) = (20_000, 10.0 / 20_000.0);
+        let tail = (0..=n)
+            .map(|k| {
+                let w = if k == 0 || k == n {
+                    1.0
+                } else {
+                    [2.0, 4.0][k % 2]
+                };
+                w * f(ZIG_R + k as f64 * h)
+            })
+            .sum::<f64>()
+            * h
+            / 3.0;
+        let base = ZIG_R * f(ZIG_R) + tail;
+        assert!((base - ZIG_V).abs() < 2e-9 * ZIG_V, "base layer {base}");
+    }
+
+    /// Moments of 400,000 ziggurat normals as for Box–Muller below, the tail
+    /// probability P(|z| > 3) = 0.0026998 within 4 sigma (1.0e-4), and the fraction
+    /// beyond the ziggurat's edge r = 3.654 (2.58e-4) within 4 sigma (1.0e-4).
+    #[test]
+    fn ziggurat_moments_and_tails() {
+        let mut n = Noise::new(11, 0);
+        let xs: Vec<f64> = (0..400_000).map(|_| n.normal_ziggurat()).collect();
+        let len = xs.len() as f64;
+        let m = xs.iter().sum::<f64>() / len;
+        let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / len;
+        let k = xs.iter().map(|x| (x - m).powi(4)).sum::<f64>() / len / (v * v);
+        assert!(m.abs() < 0.0064, "{m}");
+        assert!((v - 1.0).abs() < 0.009, "{v}");
+        assert!((k - 3.0).abs() < 0.04, "{k}");
+        let beyond = |a: f64| xs.iter().filter(|x| x.abs() > a).count() as f64 / len;
+        assert!(
+            (beyond(3.0) - 0.002_699_8).abs() < 1.0e-4,
+            "{}",
+            beyond(3.0)
+        );
+        assert!(
+            (beyond(ZIG_R) - 2.58e-4).abs() < 1.0e-4,
+            "{}",
+            beyond(ZIG_R)
+        );
+        assert!(xs.iter().any(|x| x.abs() > ZIG_R), "the tail is sampled");
     }
 
     /// Moments of 200,000 normals: mean within 4 sigma of 0 (4/sqrt(n) = 0.009),

@@ -29,7 +29,7 @@
 use super::motion::{MotionBuilder, MotionError, Piece, Shape, Start, VelocityAxes};
 use super::spline::SplineTrajectory;
 use crate::earth::{EarthModel, Geodetic};
-use crate::rotation::Euler;
+use crate::rotation::{Euler, wrap_pi};
 use crate::units::{self, Dimension};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -444,16 +444,6 @@ fn offset_to<E: EarthModel>(earth: &E, s: &Start, p: &Geodetic) -> (Vector3<f64>
     let d_e = earth.geodetic_to_ecef(p) - earth.geodetic_to_ecef(&s.pos);
     let d_n = crate::earth::c_ne(s.pos.lat, s.pos.lon).transpose() * d_e;
     (d_n, d_n.y.atan2(d_n.x))
-}
-
-/// Wrap an angle to (-pi, pi].
-fn wrap_pi(x: f64) -> f64 {
-    let w = (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    if w == -std::f64::consts::PI {
-        std::f64::consts::PI
-    } else {
-        w
-    }
 }
 
 /// Turn towards `p` if the heading is off by more than the tolerance, at a bank no

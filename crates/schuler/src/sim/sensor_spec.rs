@@ -12,6 +12,12 @@
 //! | `tactical` | 1 deg/h | 0.1 deg/h (1800 s) | 0.1 deg/sqrt(h) | 1 mg | 50 ug (1800 s) | 0.05 m/s/sqrt(h) | 100 / 300 ppm |
 //! | `consumer-mems` | 10 deg/h | 3 deg/h (300 s) | 0.5 deg/sqrt(h) | 5 mg | 0.5 mg (300 s) | 0.2 m/s/sqrt(h) | 1000 / 3000 ppm |
 //! | `perfect` | none | | | | | | |
+//!
+//! The presets leave out what the references tabulate less uniformly; give them per
+//! triad when wanted: the bias random walk (`rate_random_walk`, e.g.
+//! "0.01 deg/h/sqrt(h)", or `acceleration_random_walk`, e.g. "10 ug/sqrt(h)"),
+//! misalignment, asymmetry, quantization, and the gyro g-sensitivity
+//! (`g_sensitivity = "2 deg/h/g"` in `[imu]`).
 
 use super::imu_model::{ImuModel, TriadModel, VibrationLine};
 use super::receivers::{BaroModel, GnssModel, Interval, Outlier};
@@ -66,6 +72,16 @@ pub struct TriadSpec {
     pub correlation_time: Option<Axes>,
     /// White noise: angle random walk (gyro) or velocity random walk (accelerometer).
     pub random_walk: Option<Axes>,
+    /// Random walk of the bias: rate random walk (gyro, e.g. "0.01 deg/h/sqrt(h)") or
+    /// acceleration random walk (accelerometer, e.g. "10 ug/sqrt(h)"); also read as
+    /// `rate_random_walk` or `acceleration_random_walk`.
+    #[serde(
+        default,
+        alias = "rate_random_walk",
+        alias = "acceleration_random_walk",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub bias_random_walk: Option<Axes>,
     /// Scale-factor error.
     pub scale: Option<Axes>,
     /// Scale-factor asymmetry.
@@ -88,6 +104,7 @@ impl TriadSpec {
             instability,
             correlation_time,
             random_walk,
+            bias_random_walk,
             scale,
             asymmetry,
             misalignment,
@@ -95,13 +112,13 @@ impl TriadSpec {
         )
     }
 
-    fn resolve(
-        &self,
-        key: &str,
-        rate: Dimension,
-        white: Dimension,
-        quantum: Dimension,
-    ) -> Result<TriadModel, ScenarioError> {
+    fn resolve(&self, key: &str, dims: &TriadDimensions) -> Result<TriadModel, ScenarioError> {
+        let TriadDimensions {
+            rate,
+            white,
+            walk,
+            quantum,
+        } = *dims;
         let get =
             |f: &Option<Axes>, name: &str, dim: Dimension| -> Result<Vector3<f64>, ScenarioError> {
                 f.as_ref().map_or(Ok(Vector3::zeros()), |a| {
@@ -121,7 +138,7 @@ impl TriadSpec {
             gm_sigma: get(&self.instability, "instability", rate)?,
             gm_tau: get(&self.correlation_time, "correlation_time", Dimension::Time)?,
             white: get(&self.random_walk, "random_walk", white)?,
-            random_walk: Vector3::zeros(),
+            random_walk: get(&self.bias_random_walk, "bias_random_walk", walk)?,
             scale: get(&self.scale, "scale", Dimension::Dimensionless)?,
             asymmetry: get(&self.asymmetry, "asymmetry", Dimension::Dimensionless)?,
             misalignment,
@@ -138,6 +155,7 @@ impl TriadSpec {
                 ("turn_on", model.turn_on[i]),
                 ("instability", model.gm_sigma[i]),
                 ("random_walk", model.white[i]),
+                ("bias_random_walk", model.random_walk[i]),
                 ("quantum", model.quantum[i]),
             ] {
                 if v < 0.0 {
@@ -152,6 +170,18 @@ impl TriadSpec {
         }
         Ok(model)
     }
+}
+
+/// The dimensions of one triad's terms.
+struct TriadDimensions {
+    /// Bias, turn-on bias, instability (angular rate or acceleration).
+    rate: Dimension,
+    /// White noise density (angle or velocity random walk).
+    white: Dimension,
+    /// Random walk of the bias (rate or acceleration random walk).
+    walk: Dimension,
+    /// Quantization step (angle or velocity).
+    quantum: Dimension,
 }
 
 /// IMU grade presets.
@@ -241,9 +271,9 @@ pub struct ImuSpec {
     /// Accelerometer errors.
     #[serde(default)]
     pub accel: TriadSpec,
-    /// Gyro g-sensitivity, rad/s per m/s^2, per axis (diagonal) [dimensionless in SI:
-    /// write e.g. 1e-6].
-    pub g_sensitivity: Option<[f64; 3]>,
+    /// Gyro g-sensitivity per axis (the diagonal: each gyro's rate error per unit of
+    /// specific force along its own axis), e.g. "2 deg/h/g".
+    pub g_sensitivity: Option<Axes>,
     /// Accelerometer vibration lines.
     #[serde(default)]
     pub vibration: Vec<VibrationSpec>,
@@ -272,15 +302,21 @@ impl ImuSpec {
         let r = self.resolved_spec();
         let gyro = r.gyro.resolve(
             "imu.gyro",
-            Dimension::AngularRate,
-            Dimension::AngleRandomWalk,
-            Dimension::Angle,
+            &TriadDimensions {
+                rate: Dimension::AngularRate,
+                white: Dimension::AngleRandomWalk,
+                walk: Dimension::RateRandomWalk,
+                quantum: Dimension::Angle,
+            },
         )?;
         let accel = r.accel.resolve(
             "imu.accel",
-            Dimension::Acceleration,
-            Dimension::VelocityRandomWalk,
-            Dimension::Velocity,
+            &TriadDimensions {
+                rate: Dimension::Acceleration,
+                white: Dimension::VelocityRandomWalk,
+                walk: Dimension::AccelerationRandomWalk,
+                quantum: Dimension::Velocity,
+            },
         )?;
         let mut vibration = Vec::new();
         for (i, v) in r.vibration.iter().enumerate() {
@@ -305,9 +341,11 @@ impl ImuSpec {
         Ok(ImuModel {
             gyro,
             accel,
-            g_sensitivity: Matrix3::from_diagonal(&Vector3::from(
-                r.g_sensitivity.unwrap_or([0.0; 3]),
-            )),
+            g_sensitivity: Matrix3::from_diagonal(
+                &r.g_sensitivity.as_ref().map_or(Ok(Vector3::zeros()), |g| {
+                    g.si("imu.g_sensitivity", Dimension::GSensitivity)
+                })?,
+            ),
             vibration,
         })
     }
