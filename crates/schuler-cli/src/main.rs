@@ -30,6 +30,8 @@ enum Command {
     /// Lecture 22's systems on one trajectory: SINS, platform INS (geographic,
     /// orthodromic, free-azimuth), analytic INS and gyro-free INS, errors compared.
     Platform(schuler_cli::commands::platform::Args),
+    /// Errors of a navigation result (KF-GINS text or CSV) against a truth file.
+    Compare(schuler_cli::commands::compare::Args),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
         Command::Channel(args) => schuler_cli::commands::channel::run(args),
         Command::Vertical(args) => schuler_cli::commands::vertical::run(args),
         Command::Platform(args) => schuler_cli::commands::platform::run(args),
+        Command::Compare(args) => schuler_cli::commands::compare::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@
 pub mod aided;
 pub mod align;
 pub mod channel;
+pub mod compare;
 pub mod demo;
 pub mod kf_gins;
 pub mod nav;
