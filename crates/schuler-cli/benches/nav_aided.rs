@@ -79,6 +79,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         smooth: false,
         names: schuler_cli::commands::aided::OutputNames::SCHULER,
         initial_errors: Default::default(),
+        outage_test: None,
     };
     (settings, aiding)
 }

@@ -321,3 +321,68 @@ fn a_kf_gins_configuration_runs_as_kf_gins_does() {
         .failure()
         .stderr(predicates::str::contains("initvelstd"));
 }
+
+/// `--outage-test 30s/100s --truth`: GNSS removed 30 s of every 100 s; the report lists
+/// each outage's largest errors against the truth and their RMS, in stdout and
+/// outage_test.json, and agrees with `errors` computed here on the same file.
+#[test]
+fn the_outage_test_reports_each_outage() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = unpack(dir.path(), "IMU.txt");
+    let truth = unpack(dir.path(), "truth.nav");
+    let out = dir.path().join("ot");
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--imu"])
+        .arg(&imu)
+        .arg("--gnss")
+        .arg(common::shared_data("drive9min").join("GNSS.txt"))
+        .args([
+            "--init-pos",
+            "45.0712345678,7.6812345678,245",
+            "--init-att",
+            "0,0,10",
+        ])
+        .args(["--start", "1.0", "--outage-test", "30s/100s", "--truth"])
+        .arg(&truth)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("outage test: 4 outages of 30 s"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("outage_test.json")).expect("json"))
+            .expect("parse");
+    let outages = json["outages"].as_array().expect("outages");
+    assert_eq!(outages.len(), 4);
+    // The largest horizontal error inside each window, recomputed from nav.txt.
+    let rows = common::read_rows(&out.join("nav.txt"));
+    let truth_rows = common::read_rows(&truth);
+    let by_time: HashMap<i64, &Vec<f64>> = truth_rows
+        .iter()
+        .map(|r| ((r[1] * 100.0).round() as i64, r))
+        .collect();
+    let mut sum2 = 0.0;
+    for o in outages {
+        let (a, b) = (
+            o["from"].as_f64().expect("from"),
+            o["to"].as_f64().expect("to"),
+        );
+        let mut worst: f64 = 0.0;
+        for r in rows.iter().filter(|r| r[1] >= a - 1e-9 && r[1] <= b + 1e-9) {
+            let t = by_time[&((r[1] * 100.0).round() as i64)];
+            let lat = t[2].to_radians();
+            let radii = Wgs84.radii(lat);
+            let dn = (r[2] - t[2]).to_radians() * (radii.meridian + t[4]);
+            let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + t[4]) * lat.cos();
+            worst = worst.max(dn.hypot(de));
+        }
+        let reported = o["horizontal_max_m"].as_f64().expect("max");
+        // Same formula on the same printed numbers: agreement to round-off.
+        assert!((reported - worst).abs() < 1e-6, "{reported} vs {worst}");
+        assert!(worst > 0.1 && worst < 20.0, "{worst}");
+        sum2 += worst * worst;
+    }
+    let rms = json["rms_of_maxima"]["horizontal_m"].as_f64().expect("rms");
+    assert!((rms - (sum2 / 4.0).sqrt()).abs() < 1e-6);
+}

@@ -61,6 +61,8 @@ pub struct Aiding {
     pub names: OutputNames,
     /// Sensor errors known at the start (removed from the first sample on).
     pub initial_errors: schuler::filter::SensorEstimates,
+    /// Test outages (GNSS removed inside), with the truth to report against.
+    pub outage_test: Option<(Vec<(f64, f64)>, Option<PathBuf>)>,
 }
 
 /// What an aided run did, beyond [`NavSummary`].
@@ -387,6 +389,17 @@ pub struct AidingOptions {
     /// Initial attitude standard deviation roll, pitch, yaw [deg] (default 0.1,0.1,0.5).
     #[arg(long, value_name = "R,P,Y")]
     pub init_att_std: Option<super::nav::Triple>,
+    /// Outage test: remove GNSS for LEN every PERIOD (e.g. `60s/180s`), the first
+    /// outage starting at --outage-start (default: one PERIOD after the first fix);
+    /// with --truth, report the errors at the end of and inside each outage.
+    #[arg(long, value_name = "LEN/PERIOD")]
+    pub outage_test: Option<String>,
+    /// Start of the first test outage [s, the log's clock].
+    #[arg(long, value_name = "SOW")]
+    pub outage_start: Option<f64>,
+    /// Truth (KF-GINS navigation text or schuler CSV) for the outage test's report.
+    #[arg(long, value_name = "FILE")]
+    pub truth: Option<PathBuf>,
     /// Longest covariance propagation step (default 1 s; the covariance is always
     /// propagated to each measurement's time).
     #[arg(long, value_name = "TIME")]
@@ -417,13 +430,19 @@ impl AidingOptions {
             init_pos_std,
             init_vel_std,
             init_att_std,
+            outage_test,
+            outage_start,
+            truth,
             propagation_interval
         )
     }
 
     /// Paths relative to `base` (a config file's folder).
     pub fn relative_to(mut self, base: &Path) -> Self {
-        for p in [&mut self.gnss, &mut self.gnss_vel].into_iter().flatten() {
+        for p in [&mut self.gnss, &mut self.gnss_vel, &mut self.truth]
+            .into_iter()
+            .flatten()
+        {
             if p.is_relative() {
                 *p = base.join(&*p);
             }
@@ -517,6 +536,42 @@ impl AidingOptions {
         )? {
             noise.accel_bias_walk = Vector3::repeat(x * (2.0 / tau).sqrt());
         }
+        let outage_test = match &self.outage_test {
+            None => None,
+            Some(text) => {
+                let (len, period) = text.split_once('/').with_context(|| {
+                    format!("--outage-test {text:?}: expected LEN/PERIOD, e.g. 60s/180s")
+                })?;
+                let t = |s: &str| -> Result<f64> {
+                    parse_as_or_si(s.trim(), Dimension::Time)
+                        .with_context(|| format!("--outage-test {text:?}"))
+                };
+                let (len, period) = (t(len)?, t(period)?);
+                if !(len > 0.0 && period > len) {
+                    bail!("--outage-test {text:?}: need 0 < LEN < PERIOD");
+                }
+                let (first, last) = (
+                    fixes.first().map_or(0.0, |f| f.t),
+                    fixes.last().map_or(0.0, |f| f.t),
+                );
+                let mut start = self.outage_start.unwrap_or(first + period);
+                let mut windows = Vec::new();
+                while start + len <= last {
+                    windows.push((start, start + len));
+                    start += period;
+                }
+                if windows.is_empty() {
+                    bail!(
+                        "--outage-test {text:?}: no whole outage fits between the first and last GNSS fix"
+                    );
+                }
+                fixes.retain(|f| !windows.iter().any(|&(a, b)| f.t > a && f.t <= b));
+                Some((windows, self.truth.clone()))
+            }
+        };
+        if self.truth.is_some() && outage_test.is_none() {
+            bail!("--truth is used by --outage-test (use `schuler compare` to compare any result)");
+        }
         let gate = match self.gate {
             None => schuler::filter::Gate::Level(1e-4),
             Some(0.0) => schuler::filter::Gate::Off,
@@ -547,6 +602,7 @@ impl AidingOptions {
             smooth: self.smooth,
             names: OutputNames::SCHULER,
             initial_errors: Default::default(),
+            outage_test,
             fixes,
             config: IntegrationConfig {
                 noise,
@@ -565,4 +621,70 @@ impl AidingOptions {
             },
         }))
     }
+}
+
+/// The outage test's report: the outages, and with a truth the largest horizontal,
+/// vertical and attitude errors inside each (for an INS bridging a gap, the error at
+/// its end) and the RMS of those maxima, the protocol of the KF-GINS paper; also
+/// written to `DIR/outage_test.json`.
+pub fn report_outage_test(
+    nav: &Path,
+    windows: &[(f64, f64)],
+    truth: Option<&Path>,
+    dir: &Path,
+) -> Result<()> {
+    println!(
+        "outage test: {} outages of {:.0} s",
+        windows.len(),
+        windows[0].1 - windows[0].0
+    );
+    let Some(truth) = truth else {
+        println!("  (give --truth FILE for the errors in each outage)");
+        return Ok(());
+    };
+    let (_, nav_rows) = super::compare::read_nav(nav)?;
+    let (_, truth_rows) = super::compare::read_nav(truth)?;
+    let c = super::compare::compare(&nav_rows, &truth_rows, None, None, windows)?;
+    let mut json = Vec::new();
+    println!(
+        "  outage [s]          | horizontal max [m] | vertical max [m] | roll/pitch/yaw max [deg]"
+    );
+    for o in &c.stats.outages {
+        println!(
+            "  {:9.1}-{:9.1} | {:18.3} | {:16.3} | {:.4} {:.4} {:.4}",
+            o.from_sow,
+            o.to_sow,
+            o.horizontal,
+            o.vertical,
+            o.att.roll.to_degrees(),
+            o.att.pitch.to_degrees(),
+            o.att.yaw.to_degrees()
+        );
+        json.push(serde_json::json!({
+            "from": o.from_sow, "to": o.to_sow, "epochs": o.epochs,
+            "horizontal_max_m": o.horizontal, "vertical_max_m": o.vertical,
+            "roll_max_deg": o.att.roll.to_degrees(), "pitch_max_deg": o.att.pitch.to_degrees(),
+            "yaw_max_deg": o.att.yaw.to_degrees(),
+        }));
+    }
+    let rms = c.stats.outage_rms.map(|o| {
+        println!(
+            "  RMS of the maxima  | {:18.3} | {:16.3} | {:.4} {:.4} {:.4}",
+            o.horizontal,
+            o.vertical,
+            o.att.roll.to_degrees(),
+            o.att.pitch.to_degrees(),
+            o.att.yaw.to_degrees()
+        );
+        serde_json::json!({
+            "horizontal_m": o.horizontal, "vertical_m": o.vertical,
+            "roll_deg": o.att.roll.to_degrees(), "pitch_deg": o.att.pitch.to_degrees(),
+            "yaw_deg": o.att.yaw.to_degrees(),
+        })
+    });
+    let path = dir.join("outage_test.json");
+    let text = serde_json::to_string_pretty(
+        &serde_json::json!({ "outages": json, "rms_of_maxima": rms }),
+    )?;
+    std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
 }

@@ -190,6 +190,7 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         },
         smooth: false,
         names: OutputNames::KF_GINS,
+        outage_test: None,
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
             accel_bias: Vector3::from(y.initaccbias) * 1e-5,

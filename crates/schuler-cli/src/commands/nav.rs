@@ -903,6 +903,14 @@ pub fn run(args: NavArgs) -> Result<()> {
             c.skipped,
             summary.mean_nis_per_dof
         );
+        if let Some((windows, truth)) = &aiding.outage_test {
+            super::aided::report_outage_test(
+                &settings.out.join("nav.txt"),
+                windows,
+                truth.as_deref(),
+                &settings.out,
+            )?;
+        }
         let tried = c.position + c.velocity + c.rejected;
         if c.rejected * 10 > tried {
             eprintln!(
