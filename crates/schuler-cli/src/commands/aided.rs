@@ -62,7 +62,16 @@ pub struct Aiding {
     /// Sensor errors known at the start (removed from the first sample on).
     pub initial_errors: schuler::filter::SensorEstimates,
     /// Test outages (GNSS removed inside), with the truth to report against.
-    pub outage_test: Option<(Vec<(f64, f64)>, Option<PathBuf>)>,
+    pub outage_test: Option<OutageTest>,
+}
+
+/// The outage test of `--outage-test`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutageTest {
+    /// The outages [s].
+    pub windows: Vec<(f64, f64)>,
+    /// Truth to report the errors against.
+    pub truth: Option<PathBuf>,
 }
 
 /// What an aided run did, beyond [`NavSummary`].
@@ -566,7 +575,10 @@ impl AidingOptions {
                     );
                 }
                 fixes.retain(|f| !windows.iter().any(|&(a, b)| f.t > a && f.t <= b));
-                Some((windows, self.truth.clone()))
+                Some(OutageTest {
+                    windows,
+                    truth: self.truth.clone(),
+                })
             }
         };
         if self.truth.is_some() && outage_test.is_none() {

@@ -903,11 +903,11 @@ pub fn run(args: NavArgs) -> Result<()> {
             c.skipped,
             summary.mean_nis_per_dof
         );
-        if let Some((windows, truth)) = &aiding.outage_test {
+        if let Some(test) = &aiding.outage_test {
             super::aided::report_outage_test(
                 &settings.out.join("nav.txt"),
-                windows,
-                truth.as_deref(),
+                &test.windows,
+                test.truth.as_deref(),
                 &settings.out,
             )?;
         }

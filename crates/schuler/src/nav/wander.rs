@@ -443,6 +443,11 @@ impl<E: WanderEarth> Wander<E> {
         self
     }
 
+    /// The longitude reported at a pole [rad].
+    pub fn pole_longitude(&self) -> f64 {
+        self.pole_longitude
+    }
+
     /// The same mechanization reporting `lon` [rad] as the longitude at a pole.
     pub fn with_pole_longitude(mut self, lon: f64) -> Self {
         self.pole_longitude = wrap_pi(lon);
