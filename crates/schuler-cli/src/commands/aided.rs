@@ -13,7 +13,7 @@ use schuler::earth::EarthModel;
 use schuler::filter::integration::{Counts, SkipReason};
 use schuler::filter::{GnssFix, IntegrationConfig, Integrator, Layout};
 use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, NavState};
+use schuler::nav::{ErrorFrame, LocalLevel, Mechanization, NavState, Wander};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -127,19 +127,55 @@ fn std3(p: &nalgebra::DMatrix<f64>, o: usize) -> Vector3<f64> {
     Vector3::new(p[(o, o)], p[(o + 1, o + 1)], p[(o + 2, o + 2)]).map(|v| v.max(0.0).sqrt())
 }
 
-fn write_epoch<E: EarthModel>(
-    integ: &Integrator<LocalLevel<E>, E>,
+/// A mechanization the aided navigation can run on.
+pub trait AidedMechanization<E: EarthModel>: ErrorFrame + Sized {
+    /// Which one it is.
+    const KIND: MechanizationKind;
+    /// Start at `init`.
+    fn start(earth: E, init: NavState) -> Self;
+    /// The epoch to write (NED state, ECEF position, wander azimuth).
+    fn epoch(&self, earth: &E) -> NavEpoch;
+}
+
+impl<E: EarthModel> AidedMechanization<E> for LocalLevel<E> {
+    const KIND: MechanizationKind = MechanizationKind::Ned;
+    fn start(earth: E, init: NavState) -> Self {
+        LocalLevel::new(earth, init)
+    }
+    fn epoch(&self, earth: &E) -> NavEpoch {
+        let state = self.state();
+        NavEpoch {
+            state,
+            r_e: earth.geodetic_to_ecef(&state.pos),
+            wander_azimuth: 0.0,
+        }
+    }
+}
+
+impl<E: EarthModel> AidedMechanization<E> for Wander<E> {
+    const KIND: MechanizationKind = MechanizationKind::Wander;
+    fn start(earth: E, init: NavState) -> Self {
+        Wander::new(earth, init)
+    }
+    fn epoch(&self, _earth: &E) -> NavEpoch {
+        let (state, wander_azimuth) = self.nav_state_and_azimuth();
+        NavEpoch {
+            state,
+            r_e: self.ecef_position(),
+            wander_azimuth,
+        }
+    }
+}
+
+fn write_epoch<E: EarthModel, M: AidedMechanization<E>>(
+    integ: &Integrator<M, E>,
     earth: &E,
     nav: &mut NavWriter,
     std: &mut Table,
     err: &mut Table,
 ) -> Result<()> {
     let state = integ.state();
-    nav.write_epoch(&NavEpoch {
-        state,
-        r_e: earth.geodetic_to_ecef(&state.pos),
-        wander_azimuth: 0.0,
-    })?;
+    nav.write_epoch(&integ.mechanization().epoch(earth))?;
     let [sp, sv, sa] = integ.nav_std();
     let p = integ.covariance();
     let l = integ.layout();
@@ -163,11 +199,11 @@ fn write_epoch<E: EarthModel>(
 }
 
 /// The smoothed trajectory: `nav.txt`, `nav.csv`, `std.txt`, `imu_err.txt` in `dir`.
-fn write_smoothed<E: EarthModel>(
+fn write_smoothed<E: EarthModel, M: ErrorFrame>(
     earth: &E,
     dir: &Path,
     week: u32,
-    integ: &Integrator<LocalLevel<E>, E>,
+    integ: &Integrator<M, E>,
 ) -> Result<()> {
     let mut nav = NavWriter::create_extended(dir, week, earth)?;
     let mut std = Table::create(dir, "std.txt")?;
@@ -194,7 +230,10 @@ fn write_smoothed<E: EarthModel>(
     err.finish()
 }
 
-fn write_rejections<E: EarthModel>(dir: &Path, integ: &Integrator<LocalLevel<E>, E>) -> Result<()> {
+fn write_rejections<E: EarthModel, M: ErrorFrame>(
+    dir: &Path,
+    integ: &Integrator<M, E>,
+) -> Result<()> {
     let path = dir.join("rejected.csv");
     let mut s = String::from("t,measurement,reason,nis,threshold\n");
     let mut rows: Vec<(f64, String)> = integ
@@ -234,6 +273,22 @@ pub fn navigate_aided<E: EarthModel, I>(
     earth: E,
     settings: &NavSettings,
     aiding: &Aiding,
+    samples: I,
+    writer: NavWriter,
+    on_sample: impl FnMut(u64),
+) -> Result<AidedSummary>
+where
+    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+{
+    navigate_aided_on::<LocalLevel<E>, E, I>(earth, settings, aiding, samples, writer, on_sample)
+}
+
+/// As [`navigate_aided`] on the mechanization `M` (NED or the all-latitude wander
+/// mechanization, with which the filter works through the poles).
+pub fn navigate_aided_on<M: AidedMechanization<E>, E: EarthModel, I>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: &Aiding,
     mut samples: I,
     mut writer: NavWriter,
     mut on_sample: impl FnMut(u64),
@@ -254,7 +309,7 @@ where
         settings.init_vel,
         settings.init_att,
     );
-    let mut integ = Integrator::new(LocalLevel::new(earth, init), earth, aiding.config)
+    let mut integ = Integrator::new(M::start(earth, init), earth, aiding.config)
         .with_estimates(aiding.initial_errors);
     if aiding.smooth {
         integ = integ.with_smoother();
@@ -322,7 +377,7 @@ where
             t_last: last_t,
             last: integ.state(),
             gaps: None,
-            first_mechanization: MechanizationKind::Ned,
+            first_mechanization: M::KIND,
             handovers: Vec::new(),
         },
         counts: integ.counts,

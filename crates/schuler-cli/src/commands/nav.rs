@@ -821,11 +821,13 @@ pub fn run(args: NavArgs) -> Result<()> {
         });
     let align = align_on.then(|| align_opts.resolve()).transpose()?;
     let aiding: Option<Aiding> = aiding_opts.resolve(grade.noise()?)?;
-    if aiding.is_some() && mechanization.choice == MechanizationChoice::Wander {
-        bail!(
-            "GNSS aiding runs on the NED mechanization in this version; use --mechanization ned or auto"
-        );
-    }
+    // With aiding there is no hand-over: `auto` picks the wander mechanization when
+    // the start is above --auto-latitude, NED otherwise.
+    let aided_wander = match mechanization.choice {
+        MechanizationChoice::Ned => false,
+        MechanizationChoice::Wander => true,
+        MechanizationChoice::Auto => settings.init_pos.lat.abs() > mechanization.auto_latitude,
+    };
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
@@ -878,15 +880,28 @@ pub fn run(args: NavArgs) -> Result<()> {
     };
     let samples = head.into_iter().map(Ok).chain(&mut reader).map(compensate);
     if let Some(aiding) = &aiding {
+        use super::aided::navigate_aided_on as run_on;
         let summary = match settings.earth {
             EarthChoice::Wgs84 => {
-                let writer = NavWriter::create_extended(&settings.out, settings.week, &Wgs84)?;
-                super::aided::navigate_aided(Wgs84, &settings, aiding, samples, writer, on_sample)
+                let w = NavWriter::create_extended(&settings.out, settings.week, &Wgs84)?;
+                if aided_wander {
+                    run_on::<Wander<Wgs84>, _, _>(Wgs84, &settings, aiding, samples, w, on_sample)
+                } else {
+                    run_on::<LocalLevel<Wgs84>, _, _>(
+                        Wgs84, &settings, aiding, samples, w, on_sample,
+                    )
+                }
             }
             EarthChoice::Sphere | EarthChoice::SphereFixed => {
                 let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
-                let writer = NavWriter::create_extended(&settings.out, settings.week, &sphere)?;
-                super::aided::navigate_aided(sphere, &settings, aiding, samples, writer, on_sample)
+                let w = NavWriter::create_extended(&settings.out, settings.week, &sphere)?;
+                if aided_wander {
+                    run_on::<Wander<Sphere>, _, _>(sphere, &settings, aiding, samples, w, on_sample)
+                } else {
+                    run_on::<LocalLevel<Sphere>, _, _>(
+                        sphere, &settings, aiding, samples, w, on_sample,
+                    )
+                }
             }
         }?;
         bar.finish_and_clear();
