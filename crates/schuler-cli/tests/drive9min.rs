@@ -432,3 +432,72 @@ fn the_aided_wander_run_matches_the_ned_run() {
     }
     assert!(worst < 1e-3, "{worst} m");
 }
+
+use predicates::prelude::PredicateBooleanExt as _;
+
+/// Bad aiding options name the flag or file and never panic; a log that breaks
+/// mid-way keeps everything computed before the break.
+#[test]
+fn bad_aiding_options_name_the_flag_and_results_survive_a_late_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = unpack(dir.path(), "IMU.txt");
+    let gnss = common::shared_data("drive9min").join("GNSS.txt");
+    let nav = |extra: &[&str]| {
+        let mut c = assert_cmd::Command::cargo_bin("schuler").expect("binary");
+        c.args(["nav", "--imu"])
+            .arg(&imu)
+            .args([
+                "--init-pos",
+                "45.0712345678,7.6812345678,245",
+                "--init-att",
+                "0,0,10",
+            ])
+            .args(["--start", "1.0", "--out"])
+            .arg(dir.path().join("out"))
+            .args(extra);
+        c.assert()
+    };
+    let g = gnss.to_str().expect("utf-8 path");
+    for (extra, needle) in [
+        (vec!["--gnss", "missing.txt"], "missing.txt"),
+        (
+            vec!["--gnss", g, "--gyro-bias-std", "2 m/s"],
+            "--gyro-bias-std",
+        ),
+        (vec!["--gnss", g, "--arw", "-0.1 deg/sqrt(h)"], "--arw"),
+        (vec!["--gnss", g, "--gate", "2"], "--gate"),
+        (
+            vec!["--gnss", g, "--init-pos-std", "1,-1,1"],
+            "--init-pos-std",
+        ),
+        (vec!["--gnss", g, "--outage-test", "60s"], "--outage-test"),
+        (vec!["--gnss-vel", g], "--gnss-vel"),
+    ] {
+        nav(&extra).failure().stderr(
+            predicates::str::contains(needle).and(predicates::str::contains("panicked").not()),
+        );
+    }
+    // A log whose line 30001 is broken: the run stops there with the error, and the
+    // 29 999 epochs before it are in nav.txt.
+    let text = String::from_utf8(common::unxz(
+        &common::shared_data("drive9min").join("IMU.txt.xz"),
+    ))
+    .expect("utf-8");
+    let broken: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 30_000 {
+                "300.01 0.1 abc\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&imu, broken).expect("write");
+    nav(&["--gnss", g])
+        .failure()
+        .stderr(predicates::str::contains(":30001"));
+    let rows = common::read_rows(&dir.path().join("out/nav.txt"));
+    assert!(rows.len() >= 29_900, "{} rows kept", rows.len());
+}

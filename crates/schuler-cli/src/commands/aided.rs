@@ -391,20 +391,25 @@ where
 #[serde(deny_unknown_fields)]
 pub struct AidingOptions {
     /// GNSS log (KF-GINS text: t lat lon h std_n std_e std_d [vn ve vd std...]).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub gnss: Option<PathBuf>,
     /// GNSS velocity log (t vn ve vd [std_vn std_ve std_vd]) matched to the fixes by time.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub gnss_vel: Option<PathBuf>,
     /// Velocity standard deviation where the velocity log gives none (default 0.1 m/s).
-    #[arg(long, value_name = "SPEED")]
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
     pub gnss_vel_std: Option<String>,
     /// Antenna position in body axes, front, right, down [m].
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
     pub lever_arm: Option<super::nav::Triple>,
     /// Innovation gate: significance level of the chi-square test (default 1e-4; 0
     /// turns the gate off).
-    #[arg(long, value_name = "ALPHA")]
+    #[arg(long, allow_hyphen_values = true, value_name = "ALPHA")]
     pub gate: Option<f64>,
     /// Estimate gyro and accelerometer scale factors (21 states).
     #[arg(long)]
@@ -416,57 +421,57 @@ pub struct AidingOptions {
     #[serde(default)]
     pub smooth: bool,
     /// Angle random walk (e.g. `0.1 deg/sqrt(h)`; default from --imu-grade).
-    #[arg(long, value_name = "ARW")]
+    #[arg(long, allow_hyphen_values = true, value_name = "ARW")]
     pub arw: Option<String>,
     /// Velocity random walk (e.g. `0.08 m/s/sqrt(h)`).
-    #[arg(long, value_name = "VRW")]
+    #[arg(long, allow_hyphen_values = true, value_name = "VRW")]
     pub vrw: Option<String>,
     /// Gyro bias standard deviation (e.g. `2 deg/h`).
-    #[arg(long, value_name = "RATE")]
+    #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
     pub gyro_bias_std: Option<String>,
     /// Accelerometer bias standard deviation (e.g. `300 mGal`).
-    #[arg(long, value_name = "ACCEL")]
+    #[arg(long, allow_hyphen_values = true, value_name = "ACCEL")]
     pub accel_bias_std: Option<String>,
     /// Gyro scale-factor standard deviation (e.g. `1000 ppm`; with --scale-factors).
-    #[arg(long, value_name = "RATIO")]
+    #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
     pub gyro_scale_std: Option<String>,
     /// Accelerometer scale-factor standard deviation.
-    #[arg(long, value_name = "RATIO")]
+    #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
     pub accel_scale_std: Option<String>,
     /// Bias instability (Gauss–Markov std, e.g. `0.2 deg/h` and `2e-4 m/s^2`) with
     /// --bias-corr-time: sets the bias random walk.
-    #[arg(long, value_name = "RATE")]
+    #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
     pub gyro_bias_instability: Option<String>,
     /// Accelerometer bias instability.
-    #[arg(long, value_name = "ACCEL")]
+    #[arg(long, allow_hyphen_values = true, value_name = "ACCEL")]
     pub accel_bias_instability: Option<String>,
     /// Correlation time of the bias instability (default 1 h); given, the biases are
     /// modelled as first-order Gauss–Markov processes, otherwise as random walks.
-    #[arg(long, value_name = "TIME")]
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
     pub bias_corr_time: Option<String>,
     /// Initial position standard deviation north, east, down [m] (default 1,1,1).
-    #[arg(long, value_name = "N,E,D")]
+    #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
     pub init_pos_std: Option<super::nav::Triple>,
     /// Initial velocity standard deviation [m/s] (default 0.1,0.1,0.1).
-    #[arg(long, value_name = "N,E,D")]
+    #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
     pub init_vel_std: Option<super::nav::Triple>,
     /// Initial attitude standard deviation roll, pitch, yaw [deg] (default 0.1,0.1,0.5).
-    #[arg(long, value_name = "R,P,Y")]
+    #[arg(long, allow_hyphen_values = true, value_name = "R,P,Y")]
     pub init_att_std: Option<super::nav::Triple>,
     /// Outage test: remove GNSS for LEN every PERIOD (e.g. `60s/180s`), the first
     /// outage starting at --outage-start (default: one PERIOD after the first fix);
     /// with --truth, report the errors at the end of and inside each outage.
-    #[arg(long, value_name = "LEN/PERIOD")]
+    #[arg(long, allow_hyphen_values = true, value_name = "LEN/PERIOD")]
     pub outage_test: Option<String>,
     /// Start of the first test outage [s, the log's clock].
-    #[arg(long, value_name = "SOW")]
+    #[arg(long, allow_hyphen_values = true, value_name = "SOW")]
     pub outage_start: Option<f64>,
     /// Truth (KF-GINS navigation text or schuler CSV) for the outage test's report.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub truth: Option<PathBuf>,
     /// Longest covariance propagation step (default 1 s; the covariance is always
     /// propagated to each measurement's time).
-    #[arg(long, value_name = "TIME")]
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
     pub propagation_interval: Option<String>,
 }
 
