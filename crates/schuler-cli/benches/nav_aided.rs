@@ -75,11 +75,13 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
             init_vel_std: Vector3::repeat(0.01),
             init_att_std: Vector3::repeat(0.01f64.to_radians()),
             init_sensor_std: None,
+            baro: None,
         },
         smooth: false,
         names: schuler_cli::commands::aided::OutputNames::SCHULER,
         initial_errors: Default::default(),
         outage_test: None,
+        baro: None,
     };
     (settings, aiding)
 }

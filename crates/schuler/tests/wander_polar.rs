@@ -474,6 +474,7 @@ fn gnss_aided_flight_over_the_pole_keeps_mid_latitude_accuracy() {
         init_vel_std: Vector3::repeat(0.02),
         init_att_std: Vector3::new(0.05, 0.05, 0.2).map(f64::to_radians),
         init_sensor_std: None,
+        baro: None,
     };
     let mech = start(earth, &traj, &exact, Wander::new);
     let mut integ = Integrator::new(mech, earth, cfg);

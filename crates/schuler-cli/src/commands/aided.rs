@@ -63,6 +63,8 @@ pub struct Aiding {
     pub initial_errors: schuler::filter::SensorEstimates,
     /// Test outages (GNSS removed inside), with the truth to report against.
     pub outage_test: Option<OutageTest>,
+    /// Barometer readings `(t, h)` and their noise standard deviation [m].
+    pub baro: Option<(Vec<(f64, f64)>, f64)>,
 }
 
 /// The outage test of `--outage-test`.
@@ -325,6 +327,7 @@ where
     let mut n = 0u64;
     let mut last_t = first.t;
     let mut failure = None;
+    let mut next_baro = 0usize;
     for s in samples.by_ref() {
         let s = match s {
             Ok(s) => s,
@@ -334,6 +337,16 @@ where
             }
         };
         integ.step_with_fixes(&s, &mut fixes);
+        if let Some((readings, std)) = &aiding.baro {
+            // Readings up to half a sample past this one's end apply here.
+            while next_baro < readings.len() && readings[next_baro].0 <= s.t + 0.5 * s.dt {
+                let (t, h) = readings[next_baro];
+                if t > s.t - 0.5 * s.dt {
+                    integ.update_baro(t, h, *std);
+                }
+                next_baro += 1;
+            }
+        }
         n += 1;
         last_t = s.t;
         if decimator.take(s.t, s.dt) {
@@ -458,6 +471,16 @@ pub struct AidingOptions {
     /// Initial attitude standard deviation roll, pitch, yaw [deg] (default 0.1,0.1,0.5).
     #[arg(long, allow_hyphen_values = true, value_name = "R,P,Y")]
     pub init_att_std: Option<super::nav::Triple>,
+    /// Barometer log (`baro.csv` of `schuler simulate`: t,h_m; or `t h` rows): height
+    /// aiding with a bias state.
+    #[arg(long, value_name = "FILE")]
+    pub baro: Option<PathBuf>,
+    /// Barometer noise standard deviation (default 0.5 m).
+    #[arg(long, allow_hyphen_values = true, value_name = "LENGTH")]
+    pub baro_std: Option<String>,
+    /// Prior standard deviation of the barometer bias (default 10 m).
+    #[arg(long, allow_hyphen_values = true, value_name = "LENGTH")]
+    pub baro_bias_std: Option<String>,
     /// Outage test: remove GNSS for LEN every PERIOD (e.g. `60s/180s`), the first
     /// outage starting at --outage-start (default: one PERIOD after the first fix);
     /// with --truth, report the errors at the end of and inside each outage.
@@ -499,6 +522,9 @@ impl AidingOptions {
             init_pos_std,
             init_vel_std,
             init_att_std,
+            baro,
+            baro_std,
+            baro_bias_std,
             outage_test,
             outage_start,
             truth,
@@ -644,6 +670,21 @@ impl AidingOptions {
         if self.truth.is_some() && outage_test.is_none() {
             bail!("--truth is used by --outage-test (use `schuler compare` to compare any result)");
         }
+        let mut baro_cfg = None;
+        let baro_readings = match &self.baro {
+            None => None,
+            Some(path) => {
+                let readings = crate::formats::gnss::read_baro(path)?;
+                let std = q("baro-std", &self.baro_std, Dimension::Length)?.unwrap_or(0.5);
+                let bias =
+                    q("baro-bias-std", &self.baro_bias_std, Dimension::Length)?.unwrap_or(10.0);
+                if std <= 0.0 || bias <= 0.0 {
+                    bail!("--baro-std and --baro-bias-std must be positive");
+                }
+                baro_cfg = Some((bias, 0.0));
+                Some((readings, std))
+            }
+        };
         let gate = match self.gate {
             None => schuler::filter::Gate::Level(1e-4),
             Some(0.0) => schuler::filter::Gate::Off,
@@ -675,6 +716,7 @@ impl AidingOptions {
             names: OutputNames::SCHULER,
             initial_errors: Default::default(),
             outage_test,
+            baro: baro_readings,
             fixes,
             config: IntegrationConfig {
                 noise,
@@ -690,6 +732,7 @@ impl AidingOptions {
                 // Roll, pitch, yaw std taken about north, east, down (level attitude).
                 init_att_std: att.map(f64::to_radians),
                 init_sensor_std: None,
+                baro: baro_cfg,
             },
         }))
     }

@@ -187,15 +187,18 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
             init_vel_std: positive(&key("initvelstd"), &y.initvelstd)?,
             init_att_std: positive(&key("initattstd"), &y.initattstd)?.map(f64::to_radians),
             init_sensor_std: Some(sensor_std),
+            baro: None,
         },
         smooth: false,
         names: OutputNames::KF_GINS,
         outage_test: None,
+        baro: None,
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
             accel_bias: Vector3::from(y.initaccbias) * 1e-5,
             gyro_scale: Vector3::from(y.initgyrscale) * 1e-6,
             accel_scale: Vector3::from(y.initaccscale) * 1e-6,
+            baro_bias: 0.0,
         },
     };
     Ok(KfGinsRun { settings, aiding })

@@ -165,6 +165,83 @@ pub fn merge_velocity(
     Ok(unmatched)
 }
 
+/// Read a barometer log: `baro.csv` as `schuler simulate` writes it (header
+/// `t,h_m[,outlier]`; the outlier flag, the simulator's truth, is not read) or headerless
+/// `t h` rows. Returns `(t, h)` pairs in time order.
+pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        InputError::new(
+            InputErrorKind::Io,
+            path,
+            0,
+            None,
+            format!("cannot read: {e}"),
+        )
+    })?;
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let n = i as u64 + 1;
+        let l = line.trim();
+        if l.is_empty()
+            || l.starts_with('#')
+            || (n == 1 && l.starts_with(|c: char| c.is_ascii_alphabetic()))
+        {
+            continue;
+        }
+        let fields: Vec<&str> = l
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|f| !f.is_empty())
+            .collect();
+        if fields.len() < 2 {
+            return Err(InputError::new(
+                InputErrorKind::ColumnCount,
+                path,
+                n,
+                None,
+                "expected t and h",
+            ));
+        }
+        let mut v = [0.0; 2];
+        for (k, name) in ["time", "h"].iter().enumerate() {
+            v[k] = fields[k]
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| {
+                    InputError::new(
+                        InputErrorKind::NotANumber,
+                        path,
+                        n,
+                        Some(name),
+                        format!("not a finite number: {:?}", fields[k]),
+                    )
+                })?;
+        }
+        if let Some(&(t, _)) = out.last()
+            && v[0] <= t
+        {
+            return Err(InputError::new(
+                InputErrorKind::TimeNotIncreasing,
+                path,
+                n,
+                Some("time"),
+                format!("time {} does not increase (previous {t})", v[0]),
+            ));
+        }
+        out.push((v[0], v[1]));
+    }
+    if out.is_empty() {
+        return Err(InputError::new(
+            InputErrorKind::NoData,
+            path,
+            0,
+            None,
+            "no data line",
+        ));
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -189,6 +266,18 @@ mod tests {
             1
         );
         assert_eq!(fixes[0].vel.map(|(v, s)| (v.x, s.x)), Some((4.0, 0.05)));
+    }
+
+    #[test]
+    fn reads_the_simulators_baro_csv_and_names_bad_fields() {
+        let f = file("t,h_m,outlier\n0.1,100.5,0\n0.2,100.7,1\n");
+        assert_eq!(
+            read_baro(f.path()).expect("reads"),
+            vec![(0.1, 100.5), (0.2, 100.7)]
+        );
+        let f = file("t,h_m,outlier\n0.1,abc,0\n");
+        let e = read_baro(f.path()).expect_err("bad").to_string();
+        assert!(e.contains(":2: field h"), "{e}");
     }
 
     #[test]

@@ -58,6 +58,9 @@ pub struct IntegrationConfig {
     pub init_vel_std: Vector3<f64>,
     /// Initial attitude standard deviations (about north, east, down) [rad].
     pub init_att_std: Vector3<f64>,
+    /// Barometer: prior standard deviation of its bias [m] and the bias's random-walk
+    /// density [m/sqrt(s)]; `None` without a barometer.
+    pub baro: Option<(f64, f64)>,
     /// Initial standard deviations of gyro bias, accelerometer bias, gyro and
     /// accelerometer scale factors, when they differ from the noise model's.
     pub init_sensor_std: Option<[Vector3<f64>; 4]>,
@@ -103,6 +106,8 @@ pub struct SensorEstimates {
     pub gyro_scale: Vector3<f64>,
     /// Accelerometer scale-factor error.
     pub accel_scale: Vector3<f64>,
+    /// Barometer bias [m].
+    pub baro_bias: f64,
 }
 
 impl SensorEstimates {
@@ -124,6 +129,8 @@ pub struct Counts {
     pub position: u64,
     /// Accepted velocity updates.
     pub velocity: u64,
+    /// Accepted barometer updates.
+    pub baro: u64,
     /// Rejected by the gate.
     pub rejected: u64,
     /// Not usable (outside the IMU's time span).
@@ -167,16 +174,24 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if cfg.scale_factors {
             layout = layout.with_scale_factors();
         }
+        if cfg.baro.is_some() {
+            layout = layout.with_baro_bias();
+        }
+        let (baro_std, baro_walk) = cfg.baro.unwrap_or((0.0, 0.0));
         let model = ErrorModel {
             layout,
             noise: cfg.noise,
-            baro_bias_walk: 0.0,
+            baro_bias_walk: baro_walk,
         };
         let frame = mech.frame();
         let state = mech.state();
         let c = measurement::c_nc(&frame, &state.pos);
-        let mut p =
-            model.initial_covariance(Vector3::zeros(), Vector3::zeros(), Vector3::zeros(), 0.0);
+        let mut p = model.initial_covariance(
+            Vector3::zeros(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+            baro_std,
+        );
         let rot = |std: &Vector3<f64>| {
             c * Matrix3::from_diagonal(&std.component_mul(std)) * c.transpose()
         };
@@ -422,6 +437,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
                 match m.kind {
                     Kind::GnssPosition => self.counts.position += 1,
                     Kind::GnssVelocity => self.counts.velocity += 1,
+                    Kind::BaroHeight => self.counts.baro += 1,
                 }
                 self.feed_back(&u.dx);
                 if let Some(log) = self.smoother.as_mut() {
@@ -460,6 +476,24 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if let Some(o) = l.accel_scale {
             self.estimates.accel_scale += v3(o);
         }
+        if let Some(b) = l.baro_bias {
+            self.estimates.baro_bias += dx[b];
+        }
+    }
+
+    /// Apply a barometric height `h_baro` [m] with standard deviation `std` now (the
+    /// caller applies it at the IMU sample ending nearest its time: at 200 Hz the
+    /// offset is at most 2.5 ms, 2.5 mm at 1 m/s of climb). Ignored without a
+    /// barometer in the configuration.
+    pub fn update_baro(&mut self, t: f64, h_baro: f64, std: f64) -> bool {
+        let h = self.mech.state().pos.h;
+        let layout = self.model.layout;
+        let Some(m) = measurement::baro_height(&layout, h, h_baro, self.estimates.baro_bias, std)
+        else {
+            return false;
+        };
+        self.propagate();
+        self.apply(t, m)
     }
 }
 

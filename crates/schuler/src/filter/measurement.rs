@@ -7,6 +7,8 @@
 //! - GNSS velocity: `v_ant = v + C_cb (ω_eb^b × l)`, `ω_eb^b = ω_ib^b − C_bc ω_ie^c`:
 //!   `z = δv + [(Ĉ_cb (ω_eb × l))×] ψ − Ĉ_cb [l×] δb_g + v` (Groves 2013 §14.2.1
 //!   with the psi-angle attitude error).
+//! - Barometric height `h_b = h + b + v` with a bias state: `c`'s third axis is down in
+//!   both mechanizations, so `z = ĥ − (h_b − b̂) = −δr_z − δb + v`.
 //! - Measurement noise given in NED is turned into `c`: `R_c = C_cn R_n C_nc`.
 
 use super::layout::Layout;
@@ -22,6 +24,8 @@ pub enum Kind {
     GnssPosition,
     /// GNSS velocity.
     GnssVelocity,
+    /// Barometric height.
+    BaroHeight,
 }
 
 impl std::fmt::Display for Kind {
@@ -29,6 +33,7 @@ impl std::fmt::Display for Kind {
         f.write_str(match self {
             Kind::GnssPosition => "gnss_position",
             Kind::GnssVelocity => "gnss_velocity",
+            Kind::BaroHeight => "baro_height",
         })
     }
 }
@@ -111,4 +116,25 @@ pub fn gnss_velocity(
         h,
         r: ned_covariance(&c, std),
     }
+}
+
+/// Barometric height `h_baro` with standard deviation `std`, the bias estimated so
+/// far `bias` removed; needs a layout with a baro bias state.
+pub fn baro_height(
+    layout: &Layout,
+    h: f64,
+    h_baro: f64,
+    bias: f64,
+    std: f64,
+) -> Option<Measurement> {
+    let b = layout.baro_bias?;
+    let mut hm = DMatrix::zeros(1, layout.n);
+    hm[(0, Layout::POS + 2)] = -1.0;
+    hm[(0, b)] = -1.0;
+    Some(Measurement {
+        kind: Kind::BaroHeight,
+        z: DVector::from_element(1, h - (h_baro - bias)),
+        h: hm,
+        r: DMatrix::from_element(1, 1, std * std),
+    })
 }
