@@ -252,10 +252,11 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
     let mut epochs = Vec::new();
     for (k, (s, truth)) in d.exact.iter().zip(&d.truth).enumerate().skip(1) {
         integ.step_with_fixes(&imu.measure(s), &mut fixes);
-        if baro && k % 20 == 0 {
-            if let Some(r) = baro_sim.reading(truth.t, 0.0, truth.pos.h) {
-                integ.update_baro(r.t, r.h, 0.5);
-            }
+        if baro
+            && k % 20 == 0
+            && let Some(r) = baro_sim.reading(truth.t, 0.0, truth.pos.h)
+        {
+            integ.update_baro(r.t, r.h, 0.5);
         }
         if (truth.t - truth.t.round()).abs() < 1e-6 {
             integ.record_output();
