@@ -23,6 +23,16 @@ fn unpack(dir: &Path, name: &str) -> PathBuf {
     dst
 }
 
+/// Horizontal distance [m] between the positions of two KF-GINS navigation rows
+/// (`r` against the truth row `t`), on WGS84 radii at the truth.
+fn horizontal_error(r: &[f64], t: &[f64]) -> f64 {
+    let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
+    let radii = Wgs84.radii(truth.lat);
+    let dn = (r[2] - t[2]).to_radians() * (radii.meridian + truth.h);
+    let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
+    dn.hypot(de)
+}
+
 /// Horizontal RMS and max, vertical max [m], and the largest roll/pitch/yaw error
 /// [deg] of `nav.txt` against `truth.nav`, matched by time (both at 100 Hz).
 struct Errors {
@@ -42,11 +52,7 @@ fn errors(nav: &Path, truth: &Path) -> Errors {
     let (mut sum2, mut hmax, mut vmax, mut amax, mut n) = (0.0, 0.0f64, 0.0f64, 0.0f64, 0);
     for r in common::read_rows(nav) {
         let t = by_time[&((r[1] * 100.0).round() as i64)];
-        let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
-        let radii = Wgs84.radii(truth.lat);
-        let dn = (r[2] - t[2]).to_radians() * (radii.meridian + truth.h);
-        let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
-        let h = dn.hypot(de);
+        let h = horizontal_error(r.as_slice(), t);
         sum2 += h * h;
         hmax = hmax.max(h);
         vmax = vmax.max((r[4] - t[4]).abs());
@@ -142,12 +148,7 @@ fn attitude_rms_and_outage_max(nav: &Path, truth: &Path) -> ([f64; 3], f64) {
         }
         n += 1;
         if (215.0..=277.0).contains(&r[1]) {
-            let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
-            let radii = Wgs84.radii(truth.lat);
-            let dn = (r[2] - t[2]).to_radians() * (radii.meridian + truth.h);
-            let de =
-                (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
-            outage = outage.max(dn.hypot(de));
+            outage = outage.max(horizontal_error(&r, t));
         }
     }
     (s.map(|x| (x / n as f64).sqrt()), outage)
@@ -371,11 +372,7 @@ fn the_outage_test_reports_each_outage() {
         let mut worst: f64 = 0.0;
         for r in rows.iter().filter(|r| r[1] >= a - 1e-9 && r[1] <= b + 1e-9) {
             let t = by_time[&((r[1] * 100.0).round() as i64)];
-            let lat = t[2].to_radians();
-            let radii = Wgs84.radii(lat);
-            let dn = (r[2] - t[2]).to_radians() * (radii.meridian + t[4]);
-            let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + t[4]) * lat.cos();
-            worst = worst.max(dn.hypot(de));
+            worst = worst.max(horizontal_error(r, t));
         }
         let reported = o["horizontal_max_m"].as_f64().expect("max");
         // Same formula on the same printed numbers: agreement to round-off.

@@ -14,13 +14,10 @@ use schuler::filter::integration::{Counts, SkipReason};
 use schuler::filter::{GnssFix, IntegrationConfig, Integrator, Layout};
 use schuler::imu::ImuSample;
 use schuler::nav::{ErrorFrame, LocalLevel, Mechanization, NavState, Wander};
+use schuler::units::{DEG_PER_H, MGAL, PPM};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-
-const DPH: f64 = 3600.0 * 180.0 / std::f64::consts::PI;
-const MGAL: f64 = 1e5;
-const PPM: f64 = 1e6;
 
 /// File names of an aided run's outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -186,18 +183,24 @@ fn write_epoch<E: EarthModel, M: AidedMechanization<E>>(
     row.extend_from_slice(sp.as_slice());
     row.extend_from_slice(sv.as_slice());
     row.extend(sa.iter().map(|x| x.to_degrees()));
-    row.extend(std3(p, Layout::GYRO_BIAS).iter().map(|x| x * DPH));
-    row.extend(std3(p, Layout::ACCEL_BIAS).iter().map(|x| x * MGAL));
-    row.extend(scale(l.gyro_scale).iter().map(|x| x * PPM));
-    row.extend(scale(l.accel_scale).iter().map(|x| x * PPM));
+    row.extend(std3(p, Layout::GYRO_BIAS).iter().map(|x| x / DEG_PER_H));
+    row.extend(std3(p, Layout::ACCEL_BIAS).iter().map(|x| x / MGAL));
+    row.extend(scale(l.gyro_scale).iter().map(|x| x / PPM));
+    row.extend(scale(l.accel_scale).iter().map(|x| x / PPM));
     std.row(state.t, &row)?;
     let e = integ.estimates();
+    err.row(state.t, &imu_err_row(&e))
+}
+
+/// The KF-GINS IMU_ERR columns after time: gyro bias [deg/h], accelerometer bias
+/// [mGal], gyro and accelerometer scale factors [ppm].
+fn imu_err_row(e: &schuler::filter::SensorEstimates) -> Vec<f64> {
     let mut row = Vec::with_capacity(12);
-    row.extend(e.gyro_bias.iter().map(|x| x * DPH));
-    row.extend(e.accel_bias.iter().map(|x| x * MGAL));
-    row.extend(e.gyro_scale.iter().map(|x| x * PPM));
-    row.extend(e.accel_scale.iter().map(|x| x * PPM));
-    err.row(state.t, &row)
+    row.extend(e.gyro_bias.iter().map(|x| x / DEG_PER_H));
+    row.extend(e.accel_bias.iter().map(|x| x / MGAL));
+    row.extend(e.gyro_scale.iter().map(|x| x / PPM));
+    row.extend(e.accel_scale.iter().map(|x| x / PPM));
+    row
 }
 
 /// The smoothed trajectory: `nav.txt`, `nav.csv`, `std.txt`, `imu_err.txt` in `dir`.
@@ -219,13 +222,7 @@ fn write_smoothed<E: EarthModel, M: ErrorFrame>(
         let mut row: Vec<f64> = s.std[0].iter().chain(s.std[1].iter()).copied().collect();
         row.extend(s.std[2].iter().map(|x| x.to_degrees()));
         std.row(s.state.t, &row)?;
-        let e = s.estimates;
-        let mut row = Vec::with_capacity(12);
-        row.extend(e.gyro_bias.iter().map(|x| x * DPH));
-        row.extend(e.accel_bias.iter().map(|x| x * MGAL));
-        row.extend(e.gyro_scale.iter().map(|x| x * PPM));
-        row.extend(e.accel_scale.iter().map(|x| x * PPM));
-        err.row(s.state.t, &row)?;
+        err.row(s.state.t, &imu_err_row(&s.estimates))?;
     }
     nav.finish()?;
     std.finish()?;

@@ -13,7 +13,7 @@ use schuler::earth::{Geodetic, Sphere, Wgs84};
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
-use schuler::units::{Dimension, parse_as_or_si};
+use schuler::units::{DEG_PER_H, Dimension, MGAL, parse_as_or_si};
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -217,9 +217,6 @@ pub fn align_on(
     r.map_err(anyhow::Error::new)
 }
 
-const DPH: f64 = 3600.0 * 180.0 / std::f64::consts::PI;
-const MGAL: f64 = 1e5;
-
 fn deg3(v: &Vector3<f64>) -> [f64; 3] {
     v.map(f64::to_degrees).into()
 }
@@ -241,33 +238,26 @@ pub fn summary_text(a: &Alignment, timing: &[(&str, f64)]) -> String {
         s,
         "stage  | t_end [s] | roll ± std [deg]      | pitch ± std [deg]     | yaw ± std [deg]"
     );
-    let _ = writeln!(
-        s,
-        "coarse | {:9.2} | {:9.5} ± {:8.5} | {:9.5} ± {:8.5} | {:9.4} ± {:7.4}",
-        a.t_coarse,
-        c.roll.to_degrees(),
-        cd.x,
-        c.pitch.to_degrees(),
-        cd.y,
-        c.heading_0_2pi().to_degrees(),
-        cd.z
-    );
+    let stage =
+        |s: &mut String, name: &str, t: f64, e: &schuler::rotation::Euler, sd: &Vector3<f64>| {
+            let _ = writeln!(
+                s,
+                "{name:6} | {t:9.2} | {:9.5} ± {:8.5} | {:9.5} ± {:8.5} | {:9.4} ± {:7.4}",
+                e.roll.to_degrees(),
+                sd.x,
+                e.pitch.to_degrees(),
+                sd.y,
+                e.heading_0_2pi().to_degrees(),
+                sd.z
+            );
+        };
+    stage(&mut s, "coarse", a.t_coarse, &c, &cd);
     if a.fine.is_some() {
-        let _ = writeln!(
-            s,
-            "fine   | {:9.2} | {:9.5} ± {:8.5} | {:9.5} ± {:8.5} | {:9.4} ± {:7.4}",
-            a.t_end,
-            e.roll.to_degrees(),
-            sd.x,
-            e.pitch.to_degrees(),
-            sd.y,
-            e.heading_0_2pi().to_degrees(),
-            sd.z
-        );
-        let bg = a.gyro_bias * DPH;
-        let bgs = a.gyro_bias_std * DPH;
-        let ba = a.accel_bias * MGAL;
-        let bas = a.accel_bias_std * MGAL;
+        stage(&mut s, "fine", a.t_end, &e, &sd);
+        let bg = a.gyro_bias / DEG_PER_H;
+        let bgs = a.gyro_bias_std / DEG_PER_H;
+        let ba = a.accel_bias / MGAL;
+        let bas = a.accel_bias_std / MGAL;
         let _ = writeln!(
             s,
             "gyro bias  [deg/h]: {:+.5} ± {:.5}, {:+.5} ± {:.5}, {:+.5} ± {:.5}",
@@ -356,10 +346,10 @@ pub fn to_json(a: &Alignment) -> serde_json::Value {
         "roll_std_deg": a.attitude_std.x.to_degrees(),
         "pitch_std_deg": a.attitude_std.y.to_degrees(),
         "yaw_std_deg": a.attitude_std.z.to_degrees(),
-        "gyro_bias_dph": <[f64; 3]>::from(a.gyro_bias * DPH),
-        "gyro_bias_std_dph": <[f64; 3]>::from(a.gyro_bias_std * DPH),
-        "accel_bias_mgal": <[f64; 3]>::from(a.accel_bias * MGAL),
-        "accel_bias_std_mgal": <[f64; 3]>::from(a.accel_bias_std * MGAL),
+        "gyro_bias_dph": <[f64; 3]>::from(a.gyro_bias / DEG_PER_H),
+        "gyro_bias_std_dph": <[f64; 3]>::from(a.gyro_bias_std / DEG_PER_H),
+        "accel_bias_mgal": <[f64; 3]>::from(a.accel_bias / MGAL),
+        "accel_bias_std_mgal": <[f64; 3]>::from(a.accel_bias_std / MGAL),
         "t_start": a.t_start,
         "t_coarse": a.t_coarse,
         "t_end": a.t_end,
@@ -407,8 +397,8 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
     );
     for c in &fine.convergence {
         let a = c.attitude_std.map(f64::to_degrees);
-        let g = c.gyro_bias_std * DPH;
-        let b = c.accel_bias_std * MGAL;
+        let g = c.gyro_bias_std / DEG_PER_H;
+        let b = c.accel_bias_std / MGAL;
         let _ = writeln!(
             csv,
             "{},{},{},{},{},{},{},{},{},{}",

@@ -17,6 +17,7 @@ use schuler::earth::Geodetic;
 use schuler::filter::integration::SensorEstimates;
 use schuler::filter::{Gate, IntegrationConfig};
 use schuler::rotation::Euler;
+use schuler::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MGAL, PPM};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -62,8 +63,6 @@ struct KfGinsYaml {
     imunoise: ImuNoiseYaml,
     antlever: [f64; 3],
 }
-
-const DEG_PER_H: f64 = std::f64::consts::PI / 180.0 / 3600.0;
 
 /// A run set up from a KF-GINS configuration.
 #[derive(Debug, Clone)]
@@ -126,13 +125,13 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
     let key = |k: &str| format!("{}: {k}", path.display());
     let tau = n.corrtime * 3600.0;
     let gb = non_negative(&key("imunoise.gbstd"), &n.gbstd)? * DEG_PER_H;
-    let ab = non_negative(&key("imunoise.abstd"), &n.abstd)? * 1e-5;
-    let gs = non_negative(&key("imunoise.gsstd"), &n.gsstd)? * 1e-6;
-    let as_ = non_negative(&key("imunoise.asstd"), &n.asstd)? * 1e-6;
+    let ab = non_negative(&key("imunoise.abstd"), &n.abstd)? * MGAL;
+    let gs = non_negative(&key("imunoise.gsstd"), &n.gsstd)? * PPM;
+    let as_ = non_negative(&key("imunoise.asstd"), &n.asstd)? * PPM;
     let walk = |s: Vector3<f64>| s * (2.0 / tau).sqrt();
     let noise = schuler::filter::ImuNoise {
-        arw: non_negative(&key("imunoise.arw"), &n.arw)? * (std::f64::consts::PI / 180.0 / 60.0),
-        vrw: non_negative(&key("imunoise.vrw"), &n.vrw)? / 60.0,
+        arw: non_negative(&key("imunoise.arw"), &n.arw)? * DEG_PER_SQRT_H,
+        vrw: non_negative(&key("imunoise.vrw"), &n.vrw)? * M_PER_S_PER_SQRT_H,
         gyro_bias: gb,
         gyro_bias_walk: walk(gb),
         accel_bias: ab,
@@ -149,9 +148,9 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         };
     let sensor_std = [
         init_std("initbgstd", y.initbgstd, gb, DEG_PER_H)?,
-        init_std("initbastd", y.initbastd, ab, 1e-5)?,
-        init_std("initsgstd", y.initsgstd, gs, 1e-6)?,
-        init_std("initsastd", y.initsastd, as_, 1e-6)?,
+        init_std("initbastd", y.initbastd, ab, MGAL)?,
+        init_std("initsgstd", y.initsgstd, gs, PPM)?,
+        init_std("initsastd", y.initsastd, as_, PPM)?,
     ];
     let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)?;
     fixes.retain(|f| f.t >= y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));
@@ -195,9 +194,9 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         baro: None,
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
-            accel_bias: Vector3::from(y.initaccbias) * 1e-5,
-            gyro_scale: Vector3::from(y.initgyrscale) * 1e-6,
-            accel_scale: Vector3::from(y.initaccscale) * 1e-6,
+            accel_bias: Vector3::from(y.initaccbias) * MGAL,
+            gyro_scale: Vector3::from(y.initgyrscale) * PPM,
+            accel_scale: Vector3::from(y.initaccscale) * PPM,
             baro_bias: 0.0,
         },
     };

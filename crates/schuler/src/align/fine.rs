@@ -22,7 +22,9 @@ use crate::filter::interval::Interval;
 use crate::filter::{ErrorModel, Gate, ImuNoise, Kalman, Layout};
 use crate::imu::ImuSample;
 use crate::nav::{ErrorFrame, LocalLevel, Mechanization, NavErrors, NavState};
-use crate::rotation::{Euler, quaternion_from_rotation_vector, rotation_vector_from_quaternion};
+use crate::rotation::{
+    Euler, quaternion_from_rotation_vector, rotation_vector_from_quaternion, wrap_pi,
+};
 use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion, Vector3};
 
 /// Measurement noise of the fine alignment's observations.
@@ -80,15 +82,12 @@ pub fn euler_covariance(q_bn: &UnitQuaternion<f64>, p_psi: &Matrix3<f64>) -> Mat
         d[i] = h;
         let plus = Euler::from_quaternion(&(quaternion_from_rotation_vector(&d) * q_bn));
         let minus = Euler::from_quaternion(&(quaternion_from_rotation_vector(&-d) * q_bn));
-        let wrap = |a: f64| {
-            (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-        };
         j.set_column(
             i,
             &(Vector3::new(
-                wrap(plus.roll - minus.roll),
-                wrap(plus.pitch - minus.pitch),
-                wrap(plus.yaw - minus.yaw),
+                wrap_pi(plus.roll - minus.roll),
+                wrap_pi(plus.pitch - minus.pitch),
+                wrap_pi(plus.yaw - minus.yaw),
             ) / (2.0 * h)),
         );
     }
