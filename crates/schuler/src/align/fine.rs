@@ -160,7 +160,8 @@ pub fn fine_align<E: EarthModel>(
         let q_before = mech.state().q_bn;
         mech.step(&comp);
         let v = mech.state().v_n;
-        acc.add(&comp, &q_before, &v_prev, &v);
+        acc.add(&comp, &q_before);
+        acc.add_velocity(comp.dt, &v_prev, &v);
         v_prev = v;
         let last = k + 1 == samples.len();
         if acc.t < cfg.window - 0.5 * s.dt && !last {

@@ -313,10 +313,8 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     pub fn step(&mut self, raw: &ImuSample) {
         let s = self.estimates.compensate(raw);
         let q_bc = self.mech.q_bc();
-        let v0 = self.mech.state().v_n;
         self.mech.step(&s);
-        let v1 = self.mech.state().v_n;
-        self.interval.add(&s, &q_bc, &v0, &v1);
+        self.interval.add(&s, &q_bc);
         if s.dt > 0.0 {
             self.w_ib_b = s.dtheta / s.dt;
         }

@@ -17,25 +17,23 @@ pub struct Interval {
     pub f_b_dt: Vector3<f64>,
     /// `Σ dθ` [rad].
     pub w_b_dt: Vector3<f64>,
-    /// `∫ v̂ dt` (trapezoid) [m].
+    /// `∫ v̂ dt` (trapezoid) [m], when [`Interval::add_velocity`] is called.
     pub v_dt: Vector3<f64>,
 }
 
 impl Interval {
-    /// Add a (compensated) sample, with the attitude before it and the velocity before
-    /// and after it.
-    pub fn add(
-        &mut self,
-        s: &ImuSample,
-        q_bc: &UnitQuaternion<f64>,
-        v0: &Vector3<f64>,
-        v1: &Vector3<f64>,
-    ) {
+    /// Add a (compensated) sample, with the attitude before it.
+    pub fn add(&mut self, s: &ImuSample, q_bc: &UnitQuaternion<f64>) {
         self.t += s.dt;
         self.f_c_dt += q_bc * s.dvel;
         self.f_b_dt += s.dvel;
         self.w_b_dt += s.dtheta;
-        self.v_dt += (v0 + v1) * (0.5 * s.dt);
+    }
+
+    /// Add the velocity before and after a sample of length `dt` to `∫ v̂ dt` (for a
+    /// window-mean velocity observation).
+    pub fn add_velocity(&mut self, dt: f64, v0: &Vector3<f64>, v1: &Vector3<f64>) {
+        self.v_dt += (v0 + v1) * (0.5 * dt);
     }
 
     /// The mean kinematics, with the frame at the interval's end.
