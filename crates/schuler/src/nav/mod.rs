@@ -12,6 +12,7 @@
 //! and step history to the other without loss ([`Wander::from_local_level`],
 //! [`Wander::to_local_level`]).
 
+pub mod baro_loop;
 pub mod frame;
 pub mod local_level;
 pub mod platform;
@@ -19,6 +20,7 @@ pub mod state;
 pub mod strapdown;
 pub mod wander;
 
+pub use baro_loop::BaroLoop;
 pub use frame::{ErrorFrame, FrameSnapshot, NavErrors};
 pub use local_level::LocalLevel;
 pub use state::NavState;
