@@ -217,6 +217,17 @@ impl ImuSimulator {
         (self.gyro.turn_on, self.accel.turn_on)
     }
 
+    /// The biases in effect now, gyro [rad/s] and accelerometer [m/s^2]: constant,
+    /// turn-on, Gauss–Markov and random-walk parts summed (the truth an estimator's
+    /// bias estimates are compared with).
+    pub fn biases(&self) -> (Vector3<f64>, Vector3<f64>) {
+        let sum = |m: &TriadModel, s: &TriadState| m.bias + s.turn_on + s.gm + s.rw;
+        (
+            sum(&self.model.gyro, &self.gyro),
+            sum(&self.model.accel, &self.accel),
+        )
+    }
+
     /// The measured sample for a true sample.
     pub fn measure(&mut self, truth: &ImuSample) -> ImuSample {
         let dt = truth.dt;
@@ -271,6 +282,37 @@ mod tests {
         assert_eq!(y.dtheta.x, 1e-3 + 1e-5 * 0.005);
         assert_eq!(y.dtheta.y, -2e-3);
         assert_relative_eq!(y.dvel.z, -0.049 * 1.0001, max_relative = 1e-16);
+    }
+
+    /// The reported biases are the ones in the samples: with no noise, scale or
+    /// misalignment, a zero motion measures `b dt` exactly, sample after sample, while
+    /// the Gauss–Markov and random-walk parts move.
+    #[test]
+    fn reported_biases_are_the_ones_applied() {
+        let mut m = ImuModel::default();
+        let v = Vector3::new(1e-5, 2e-5, 3e-5);
+        for t in [&mut m.gyro, &mut m.accel] {
+            t.bias = v;
+            t.turn_on = v;
+            t.gm_sigma = v;
+            t.gm_tau = Vector3::repeat(10.0);
+            t.random_walk = v;
+        }
+        let mut sim = ImuSimulator::new(m, 3);
+        let zero = |k: u32| ImuSample {
+            t: f64::from(k) * 0.01,
+            dt: 0.01,
+            dtheta: Vector3::zeros(),
+            dvel: Vector3::zeros(),
+        };
+        let first = sim.biases();
+        for k in 1..=100 {
+            let y = sim.measure(&zero(k));
+            let (bg, ba) = sim.biases();
+            assert_relative_eq!(y.dtheta / 0.01, bg, max_relative = 1e-12);
+            assert_relative_eq!(y.dvel / 0.01, ba, max_relative = 1e-12);
+        }
+        assert_ne!(sim.biases(), first);
     }
 
     /// Quantization: every output is a whole number of steps, and the running sum
