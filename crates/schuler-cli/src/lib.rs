@@ -5,3 +5,4 @@ pub mod commands;
 pub mod formats;
 pub mod output;
 pub mod plot;
+pub mod report;

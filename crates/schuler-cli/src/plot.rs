@@ -16,6 +16,7 @@
 //! assert!(svg.starts_with("<svg") && svg.contains("dV [m/s]"));
 //! ```
 
+use crate::report::escape as esc;
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -431,13 +432,6 @@ fn thin(points: &[(f64, f64)], x0: f64, x1: f64, columns: usize) -> Vec<Vec<(f64
             out
         })
         .collect()
-}
-
-/// Escapes text for SVG.
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }
 
 #[cfg(test)]

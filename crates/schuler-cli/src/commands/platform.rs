@@ -330,19 +330,19 @@ const QUANTITIES: [Panel; 10] = [
     Panel {
         file: "tilt_north.svg",
         title: "Attitude error about north",
-        label: "[arcsec]",
+        label: "psi_N [arcsec]",
         pick: |e| e.attitude.x / ARCSEC,
     },
     Panel {
         file: "tilt_east.svg",
         title: "Attitude error about east",
-        label: "[arcsec]",
+        label: "psi_E [arcsec]",
         pick: |e| e.attitude.y / ARCSEC,
     },
     Panel {
         file: "heading.svg",
         title: "Heading error (about down)",
-        label: "[arcsec]",
+        label: "psi_D [arcsec]",
         pick: |e| e.attitude.z / ARCSEC,
     },
 ];
