@@ -129,8 +129,16 @@ mod tests {
         // After 600 s = 20 time constants the transient is e^-20 of the start; the
         // discrete feedback at 10 Hz differs from (34) by O(|k1| Δt) = 0.7 % of the
         // offset; the free channel's gravity gradient is linearized in (37): 1e-3 m.
-        assert!((s.pos.h - h0 - dh).abs() < 0.01 * dh.abs() + 1e-3, "{} vs {dh}", s.pos.h - h0);
-        assert!((-s.v_n.z - dv).abs() < 0.01 * dv.abs(), "{} vs {dv}", -s.v_n.z);
+        assert!(
+            (s.pos.h - h0 - dh).abs() < 0.01 * dh.abs() + 1e-3,
+            "{} vs {dh}",
+            s.pos.h - h0
+        );
+        assert!(
+            (-s.v_n.z - dv).abs() < 0.01 * dv.abs(),
+            "{} vs {dv}",
+            -s.v_n.z
+        );
         assert_eq!(lp.counts.accepted, 6000);
     }
 

@@ -1,0 +1,207 @@
+//! `schuler demo`: the second seed document's flight test re-enacted end to end.
+//!
+//! A helicopter sortie above the Arctic circle is simulated in memory (FOG-class IMU at
+//! 1 kHz with rotor vibration, GNSS at 1 Hz, barometer; 15 min on the pad and 45 min of
+//! flight with a GNSS outage, `examples/polar_flight.toml`), then processed as the
+//! seed's system does: coarse alignment 0–190 s, fine alignment 190–860 s, then
+//! navigation in the inertial mode (free, with and without the baro loop on the
+//! vertical channel; also after coarse alignment alone, the seed's comparison) and in
+//! the inertial-satellite mode (Kalman filter on GNSS position and velocity and the
+//! barometer, forward and smoothed). Everything goes into one self-contained HTML
+//! report with the CSV and SVG files behind its plots.
+
+mod capture;
+mod errors;
+mod modes;
+mod page;
+mod sortie;
+
+use anyhow::{Context, Result};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use nalgebra::Vector3;
+use schuler::align::{AlignConfig, Alignment, align};
+use schuler::earth::Wgs84;
+use schuler::filter::ImuNoise;
+use std::path::PathBuf;
+use std::time::Instant;
+
+pub use sortie::{POLAR_FLIGHT, Sortie};
+
+/// Arguments of `schuler demo`.
+#[derive(clap::Args, Debug)]
+pub struct DemoArgs {
+    /// Output directory.
+    #[arg(long, default_value = "schuler-demo")]
+    pub out: PathBuf,
+    /// A shortened sortie (200 Hz, 5 min on the pad, 7 min of flight) that runs in
+    /// seconds.
+    #[arg(long)]
+    pub quick: bool,
+}
+
+/// One navigation mode's run and its errors.
+pub struct ModeRun {
+    /// File-name key.
+    pub key: &'static str,
+    /// What it is.
+    pub label: &'static str,
+    /// The track.
+    pub track: modes::Track,
+    /// Its errors against the truth.
+    pub errors: Vec<errors::ErrorEpoch>,
+}
+
+/// Both alignments: coarse and fine from the start, and coarse alone over the last
+/// coarse-stage length before navigation (so both end at the same instant).
+pub struct Alignments {
+    /// Coarse 0–190 s, fine 190–860 s.
+    pub fine: Alignment,
+    /// Coarse only, 670–860 s.
+    pub coarse_only: Alignment,
+}
+
+fn bar(multi: &MultiProgress, name: &str, len: u64) -> ProgressBar {
+    let b = multi.add(ProgressBar::new(len));
+    b.set_style(
+        ProgressStyle::with_template("{prefix:>28} [{bar:30}] {pos:>5}/{len} s  {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    b.set_prefix(name.to_string());
+    b
+}
+
+fn align_both(rec: &capture::Recording, s: &Sortie) -> Result<Alignments> {
+    let noise = ImuNoise::from_model(&rec.model);
+    let pos = rec.truth[0].state.pos;
+    let cfg = AlignConfig {
+        coarse: s.coarse,
+        fine: s.fine,
+        ..AlignConfig::default()
+    };
+    let fine = align(Wgs84, pos, &rec.imu[1..], &noise, &cfg).context("fine alignment")?;
+    let from = rec.sample_at(s.nav_start() - s.coarse) + 1;
+    let coarse_only = align(
+        Wgs84,
+        pos,
+        &rec.imu[from..],
+        &noise,
+        &AlignConfig { fine: 0.0, ..cfg },
+    )
+    .context("coarse-only alignment")?;
+    Ok(Alignments { fine, coarse_only })
+}
+
+/// `schuler demo`.
+pub fn run(args: DemoArgs) -> Result<()> {
+    let started = Instant::now();
+    let sortie = if args.quick {
+        Sortie::quick()?
+    } else {
+        Sortie::full()?
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
+
+    let clock = Instant::now();
+    let (traj, _) = sortie.spec.trajectory(Wgs84).context("the sortie")?;
+    let span = traj.end() - traj.start();
+    let rec = capture::record(&sortie.spec, bar(&multi, "simulate", span as u64))?;
+    let simulate_s = clock.elapsed().as_secs_f64();
+
+    let clock = Instant::now();
+    let align_bar = bar(&multi, "align (coarse, fine)", 2);
+    let alignments = align_both(&rec, &sortie)?;
+    align_bar.inc(2);
+    align_bar.finish();
+    let align_s = clock.elapsed().as_secs_f64();
+
+    let fine_start = modes::Start::from_alignment(&alignments.fine);
+    let coarse_start = modes::Start::from_alignment(&alignments.coarse_only);
+    let gains = modes::baro_gains(&fine_start.state)?;
+    let flight = (span - sortie.nav_start()) as u64;
+    let gnss = sortie.spec.gnss.as_ref().context("the sortie has GNSS")?;
+    let lever = gnss
+        .lever_arm
+        .as_ref()
+        .map(|l| {
+            let si = |i: usize| l[i].si("gnss.lever_arm", schuler::units::Dimension::Length);
+            Ok::<_, anyhow::Error>(Vector3::new(si(0)?, si(1)?, si(2)?))
+        })
+        .transpose()?
+        .unwrap_or_default();
+    let aided_settings = modes::AidedSettings {
+        lever_arm: lever,
+        baro_std: 0.5,
+        baro_bias: (10.0, 0.05),
+    };
+    let bars = [
+        bar(&multi, "inertial-satellite (KF)", flight),
+        bar(&multi, "inertial, baro loop", flight),
+        bar(&multi, "inertial, coarse only", flight),
+        bar(&multi, "inertial, no baro", flight),
+    ];
+    let ((forward, smoothed), inertial, coarse_only, no_baro) = std::thread::scope(|scope| {
+        let aided = scope.spawn(|| {
+            modes::aided(
+                &rec,
+                &fine_start,
+                &alignments.fine,
+                &aided_settings,
+                &bars[0],
+            )
+        });
+        let inertial = modes::inertial(&rec, &fine_start, Some(gains), &bars[1]);
+        let coarse_only = modes::inertial(&rec, &coarse_start, Some(gains), &bars[2]);
+        let no_baro = modes::inertial(&rec, &fine_start, None, &bars[3]);
+        let aided = aided
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e));
+        (aided, inertial, coarse_only, no_baro)
+    });
+    for b in &bars {
+        b.finish();
+    }
+    let runs: Vec<ModeRun> = [
+        (
+            "inertial_coarse",
+            "inertial, coarse alignment only",
+            coarse_only,
+        ),
+        ("inertial", "inertial (baro loop)", inertial),
+        (
+            "inertial_no_baro",
+            "inertial, free vertical channel",
+            no_baro,
+        ),
+        ("aided", "inertial-satellite, forward", forward),
+        ("smoothed", "inertial-satellite, smoothed", smoothed),
+    ]
+    .into_iter()
+    .map(|(key, label, track)| ModeRun {
+        key,
+        label,
+        errors: errors::errors(&track, &rec),
+        track,
+    })
+    .collect();
+
+    let timing = page::Timing {
+        simulate: simulate_s,
+        align: align_s,
+    };
+    let summary = page::write(
+        &args.out,
+        &sortie,
+        &rec,
+        &alignments,
+        &runs,
+        gains,
+        timing,
+        started,
+    )?;
+    multi.clear().ok();
+    println!("{summary}");
+    Ok(())
+}
