@@ -166,17 +166,17 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let runs: Vec<ModeRun> = [
         (
             "inertial_coarse",
-            "inertial, coarse alignment only",
+            "inertial after coarse alignment only",
             coarse_only,
         ),
-        ("inertial", "inertial (baro loop)", inertial),
+        ("inertial", "inertial with baro loop", inertial),
         (
             "inertial_no_baro",
-            "inertial, free vertical channel",
+            "inertial with free vertical channel",
             no_baro,
         ),
-        ("aided", "inertial-satellite, forward", forward),
-        ("smoothed", "inertial-satellite, smoothed", smoothed),
+        ("aided", "inertial-satellite forward", forward),
+        ("smoothed", "inertial-satellite smoothed", smoothed),
     ]
     .into_iter()
     .map(|(key, label, track)| ModeRun {

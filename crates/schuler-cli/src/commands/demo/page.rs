@@ -108,6 +108,7 @@ fn write_mode(dir: &Path, run: &ModeRun) -> Result<()> {
 
 /// One row of the summary table (the same strings go to `summary.csv`).
 fn summary_row(run: &ModeRun, s: &Sortie, end: f64) -> Vec<String> {
+    debug_assert!(!run.label.contains(','), "labels are CSV cells");
     let e = &run.errors;
     let at = |t: f64| errors::at(e, t).map_or("-".to_string(), |x| m(x.circular));
     let outage_end = s.outages.last().map_or(end, |o| o.1);
@@ -126,10 +127,11 @@ fn summary_row(run: &ModeRun, s: &Sortie, end: f64) -> Vec<String> {
         m(dh),
         yaw,
         format!("{:.2}", run.track.seconds),
+        format!("errors_{}.csv", run.key),
     ]
 }
 
-const SUMMARY_HEADER: [&str; 8] = [
+const SUMMARY_HEADER: [&str; 9] = [
     "mode",
     "dS at take-off [m]",
     "dS at end of outage [m]",
@@ -138,6 +140,7 @@ const SUMMARY_HEADER: [&str; 8] = [
     "max |dh| in flight [m]",
     "yaw error at end [arcmin]",
     "run time [s]",
+    "data",
 ];
 
 fn plot_circular(title: &str, runs: &[&ModeRun], s: &Sortie) -> Plot {
@@ -437,10 +440,19 @@ pub fn write(
         .paragraph(&format!(
             "Free strapdown navigation from the aligned state, the vertical channel damped by \
              the barometer (loop time constant {BARO_LOOP_TAU:.0} s). After the fine alignment \
-             on the invariants the largest circular error is {ratio:.1} times smaller than \
-             after coarse alignment alone (the seed: at least an order of magnitude). The \
-             error oscillates with the 84.4-minute Schuler period around the gyro drift's \
-             growth."
+             on the invariants the largest circular error is {:.1} times {} than after coarse \
+             alignment alone. The seed reports at least an order of magnitude; here the \
+             navigation-grade FOG already gives a coarse heading good to {} arcmin (1 sigma), \
+             and at {:.0} N the east gyro drift, which no alignment at rest separates from \
+             heading, holds the fine one to {} arcmin. What remains is mostly the level \
+             accelerometer biases: leveling hides them on the pad, and turns reveal them (the \
+             textbook: the cancellation holds only while the heading stays constant). The \
+             error oscillates with the 84.4-minute Schuler period.",
+            ratio.max(1.0 / ratio),
+            if ratio >= 1.0 { "smaller" } else { "larger" },
+            arcmin(a.coarse_only.attitude_std.z),
+            rec.truth[0].state.pos.lat.to_degrees(),
+            arcmin(a.fine.attitude_std.z),
         ))
         .plot_with_files(
             &p,
