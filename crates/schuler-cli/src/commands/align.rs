@@ -330,7 +330,9 @@ pub fn summary_text(a: &Alignment, timing: &[(&str, f64)]) -> String {
         .iter()
         .map(|(n, t)| format!("{n} {:.3} s", t))
         .collect();
-    let _ = writeln!(s, "run time: {}", times.join(", "));
+    if !times.is_empty() {
+        let _ = writeln!(s, "run time: {}", times.join(", "));
+    }
     s
 }
 
