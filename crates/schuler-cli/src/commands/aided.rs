@@ -3,8 +3,10 @@
 //! `nav.csv` it writes, at the output rate, `std.txt` (standard deviations) and
 //! `imu_err.txt` (estimated sensor errors) in KF-GINS's column layouts, and at the end
 //! `rejected.csv` (every measurement the gate refused or that fell outside the IMU
-//! data, with time and reason).
+//! data, with time and reason) and `innovations.csv` (every measurement tested, with
+//! its innovation, predicted standard deviations and NIS; [`super::aided_record`]).
 
+use super::aided_record::InnovationLog;
 use super::nav::{Decimator, MechanizationKind, NavSettings, NavSummary};
 use crate::output::{NavEpoch, NavWriter, push_fixed};
 use anyhow::{Context, Result, bail};
@@ -316,6 +318,7 @@ where
     integ.prime(&first);
     let mut std = Table::create(&settings.out, aiding.names.std)?;
     let mut err = Table::create(&settings.out, aiding.names.imu_err)?;
+    let mut innovations = InnovationLog::create(&settings.out)?;
     let mut fixes = aiding.fixes.iter().copied().peekable();
     let mut decimator = Decimator::new(settings.output_rate);
     decimator.take(first.t, first.dt);
@@ -344,6 +347,7 @@ where
                 next_baro += 1;
             }
         }
+        innovations.drain(&mut integ)?;
         n += 1;
         last_t = s.t;
         if decimator.take(s.t, s.dt) {
@@ -360,6 +364,7 @@ where
     let epochs = writer.finish()?;
     std.finish()?;
     err.finish()?;
+    innovations.finish()?;
     write_rejections(&settings.out, &integ)?;
     if aiding.smooth {
         write_smoothed(
@@ -375,10 +380,11 @@ where
             settings.out.display()
         )));
     }
-    let (sum, dof) = integ
-        .nis
+    let (sum, dof) = innovations
+        .rows
         .iter()
-        .fold((0.0, 0usize), |(s, d), (_, _, nis, k)| (s + nis, d + k));
+        .filter(|i| i.accepted)
+        .fold((0.0, 0usize), |(s, d), i| (s + i.nis, d + i.dof));
     Ok(AidedSummary {
         nav: NavSummary {
             samples: n,

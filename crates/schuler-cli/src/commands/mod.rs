@@ -2,6 +2,7 @@
 //! calls to readers and writers.
 
 pub mod aided;
+pub mod aided_record;
 pub mod align;
 pub mod channel;
 pub mod compare;
