@@ -760,9 +760,9 @@ pub fn report_outage_test(
         println!("  (give --truth FILE for the errors in each outage)");
         return Ok(());
     };
-    let (_, nav_rows) = super::compare::read_nav(nav)?;
-    let (_, truth_rows) = super::compare::read_nav(truth)?;
-    let c = super::compare::compare(&nav_rows, &truth_rows, None, None, windows)?;
+    let (_, nav_rows) = crate::formats::nav::read_nav(nav)?;
+    let (_, truth_rows) = crate::formats::nav::read_nav(truth)?;
+    let c = schuler::analysis::statistics::compare(&nav_rows, &truth_rows, None, None, windows)?;
     let mut json = Vec::new();
     println!(
         "  outage [s]          | horizontal max [m] | vertical max [m] | roll/pitch/yaw max [deg]"
