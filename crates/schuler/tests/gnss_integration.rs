@@ -5,13 +5,13 @@
 
 use nalgebra::Vector3;
 use schuler::analysis::consistency::{ChiSquareTest, mean_bounds, normalized_squared};
+use schuler::analysis::errors::attitude_error;
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::{GnssFix, Innovation, IntegrationConfig, Integrator};
 use schuler::filter::measurement::Kind;
 use schuler::filter::{Gate, ImuNoise};
 use schuler::imu::ImuSample;
 use schuler::nav::{LocalLevel, NavState};
-use schuler::rotation::rotation_vector_from_quaternion;
 use schuler::sim::analytic::Kinematics;
 use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::receivers::{BaroReading, GnssModel, GnssSimulator, Interval};
@@ -268,7 +268,7 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
             let c_en = schuler::earth::c_ne(truth.pos.lat, truth.pos.lon).transpose();
             let dr = c_en * (Wgs84.geodetic_to_ecef(&est.pos) - Wgs84.geodetic_to_ecef(&truth.pos));
             let dv = est.v_n - truth.v_n;
-            let psi = -rotation_vector_from_quaternion(&(est.q_bn * truth.q_bn.inverse()));
+            let psi = attitude_error(&est.q_bn, &truth.q_bn);
             let mut e = [0.0; 9];
             e[..3].copy_from_slice(dr.as_slice());
             e[3..6].copy_from_slice(dv.as_slice());

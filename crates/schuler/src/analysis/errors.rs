@@ -21,8 +21,8 @@
 //! wrapped to (-180°, 180°].
 
 use crate::earth::{EarthModel, Geodetic, Wgs84};
-use crate::rotation::{Euler, wrap_pi};
-use nalgebra::Vector3;
+use crate::rotation::{Euler, rotation_vector_from_quaternion, wrap_pi};
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// Two epochs closer than this [s] are the same epoch.
 pub const TIME_TOLERANCE_S: f64 = 1e-6;
@@ -132,6 +132,64 @@ pub fn errors_at(nav: &NavRecord, truth: &NavRecord) -> EpochErrors {
     }
 }
 
+/// Attitude error as a small rotation about north, east, down: the `ψ` with
+/// `Ĉ_bn = (I − [ψ×]) C_bn`, the filter's attitude-error convention
+/// ([`crate::filter::measurement`]), exactly `ψ = −rotvec(q̂_bn q_bn⁻¹)`.
+pub fn attitude_error(
+    q_bn_est: &UnitQuaternion<f64>,
+    q_bn_true: &UnitQuaternion<f64>,
+) -> Vector3<f64> {
+    -rotation_vector_from_quaternion(&(q_bn_est * q_bn_true.inverse()))
+}
+
+/// The truth at one time, as [`TruthCursor::at`] finds it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TruthAt {
+    /// Before the truth's first epoch (by more than [`TIME_TOLERANCE_S`]).
+    Before,
+    /// After its last epoch.
+    After,
+    /// A truth epoch within [`TIME_TOLERANCE_S`].
+    Exact(NavRecord),
+    /// Interpolated ([`interpolate`]) across a truth interval of this length [s].
+    Interpolated(NavRecord, f64),
+}
+
+/// Finds the truth at times that do not decrease, walking a sorted truth once.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TruthCursor {
+    /// `truth[j].t_sow <= t + tol`, advanced monotonically.
+    j: usize,
+}
+
+impl TruthCursor {
+    /// The truth at `t` (the epoch within [`TIME_TOLERANCE_S`], else interpolated
+    /// between the two around it); `truth` sorted by time, the same on every call.
+    pub fn at(&mut self, truth: &[NavRecord], t: f64) -> TruthAt {
+        let (Some(first), Some(last)) = (truth.first(), truth.last()) else {
+            return TruthAt::After;
+        };
+        if t < first.t_sow - TIME_TOLERANCE_S {
+            return TruthAt::Before;
+        }
+        if t > last.t_sow + TIME_TOLERANCE_S {
+            return TruthAt::After;
+        }
+        let j = &mut self.j;
+        while *j + 1 < truth.len() && truth[*j + 1].t_sow <= t + TIME_TOLERANCE_S {
+            *j += 1;
+        }
+        if (truth[*j].t_sow - t).abs() <= TIME_TOLERANCE_S {
+            TruthAt::Exact(truth[*j])
+        } else {
+            // truth[j].t < t - tol and truth[j + 1].t > t + tol: t is inside the span
+            // and not within the tolerance of its last epoch, so j + 1 exists.
+            let (a, b) = (&truth[*j], &truth[*j + 1]);
+            TruthAt::Interpolated(interpolate(a, b, t), b.t_sow - a.t_sow)
+        }
+    }
+}
+
 /// The error of every NAV epoch inside `[start, end]` and the truth's span (both
 /// sorted by time), exact within [`TIME_TOLERANCE_S`] else interpolated.
 pub fn match_epochs(
@@ -142,40 +200,33 @@ pub fn match_epochs(
 ) -> (Vec<EpochErrors>, Matching) {
     let mut m = Matching::default();
     let mut out = Vec::with_capacity(nav.len());
-    let (Some(first), Some(last)) = (truth.first(), truth.last()) else {
-        m.after_truth = nav.len();
-        return (out, m);
-    };
-    let mut j = 0; // truth[j].t_sow <= t + tol, advanced monotonically
+    let mut cursor = TruthCursor::default();
     for row in nav {
         let t = row.t_sow;
         if start.is_some_and(|s| t < s) || end.is_some_and(|e| t > e) {
             m.outside_window += 1;
             continue;
         }
-        if t < first.t_sow - TIME_TOLERANCE_S {
-            m.before_truth += 1;
-            continue;
-        }
-        if t > last.t_sow + TIME_TOLERANCE_S {
-            m.after_truth += 1;
-            continue;
-        }
-        while j + 1 < truth.len() && truth[j + 1].t_sow <= t + TIME_TOLERANCE_S {
-            j += 1;
-        }
-        let e = if (truth[j].t_sow - t).abs() <= TIME_TOLERANCE_S {
-            m.exact += 1;
-            errors_at(row, &truth[j])
-        } else {
-            // truth[j].t < t - tol and truth[j + 1].t > t + tol: t is inside the span
-            // and not within the tolerance of its last epoch, so j + 1 exists.
-            let (a, b) = (&truth[j], &truth[j + 1]);
-            m.interpolated += 1;
-            m.max_bridged_s = m.max_bridged_s.max(b.t_sow - a.t_sow);
-            EpochErrors {
-                interpolated: true,
-                ..errors_at(row, &interpolate(a, b, t))
+        let e = match cursor.at(truth, t) {
+            TruthAt::Before => {
+                m.before_truth += 1;
+                continue;
+            }
+            TruthAt::After => {
+                m.after_truth += 1;
+                continue;
+            }
+            TruthAt::Exact(truth) => {
+                m.exact += 1;
+                errors_at(row, &truth)
+            }
+            TruthAt::Interpolated(truth, bridged) => {
+                m.interpolated += 1;
+                m.max_bridged_s = m.max_bridged_s.max(bridged);
+                EpochErrors {
+                    interpolated: true,
+                    ..errors_at(row, &truth)
+                }
             }
         };
         out.push(e);
@@ -205,5 +256,25 @@ mod tests {
             e.att
         );
         assert_eq!(e.pos_n, Vector3::zeros());
+    }
+
+    #[test]
+    fn attitude_error_is_the_small_rotation_the_filter_estimates() {
+        // Truth level, heading 30 deg; the estimate turned by 1 mrad further about
+        // down: C_est = (I - [psi x]) C_true with psi = (0, 0, -1e-3).
+        let truth = Euler::from_degrees(0.0, 0.0, 30.0).to_quaternion();
+        let est = Euler::new(0.0, 0.0, 30f64.to_radians() + 1e-3).to_quaternion();
+        let psi = attitude_error(&est, &truth);
+        assert!(
+            (psi - Vector3::new(0.0, 0.0, -1e-3)).norm() < 1e-15,
+            "{psi}"
+        );
+        // A tilt about north: roll +1 mrad at zero heading is a turn about north.
+        let est = Euler::new(1e-3, 0.0, 0.0).to_quaternion();
+        let psi = attitude_error(&est, &Euler::default().to_quaternion());
+        assert!(
+            (psi - Vector3::new(-1e-3, 0.0, 0.0)).norm() < 1e-15,
+            "{psi}"
+        );
     }
 }
