@@ -213,7 +213,7 @@ pub const ERRORS_CSV_HEADER: &str = "t_sow,north_m,east_m,down_m,horizontal_m,vn
 vd_mps,roll_deg,pitch_deg,yaw_deg,interpolated";
 
 /// Writes `errors.csv`: one row per matched epoch, shortest round-trip numbers.
-fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
+pub(crate) fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
     let file =
         std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut w = std::io::BufWriter::new(file);

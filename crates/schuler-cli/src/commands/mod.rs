@@ -3,6 +3,7 @@
 
 pub mod aided;
 pub mod aided_record;
+pub mod aided_report;
 pub mod align;
 pub mod channel;
 pub mod compare;
