@@ -501,3 +501,34 @@ fn a_barometer_holds_the_height_through_outages() {
     // Half a metre of baro noise averaged over the outage: well under a metre.
     assert!(b < 1.0, "{b}");
 }
+
+/// The NIS test has teeth: the same data with the receiver's standard deviations
+/// declared 3 times too large (a 9-fold R) gives position innovations whose NIS
+/// averages far below its 3 dof, outside the interval the consistent runs meet.
+#[test]
+fn a_mismatched_noise_model_fails_the_nis_test() {
+    let (mut gnss, _) = fixes(51, &[]);
+    for f in &mut gnss {
+        f.pos_std *= 3.0;
+        f.vel = f.vel.map(|(v, std)| (v, std * 3.0));
+    }
+    let r = run(52, &gnss, &[]);
+    let t = ChiSquareTest::of(
+        r.innovations
+            .iter()
+            .filter(|i| i.accepted && i.kind == Kind::GnssPosition)
+            .map(|i| i.nis),
+        3,
+        0.95,
+    )
+    .expect("updates");
+    println!(
+        "R 9x too large: mean position NIS {:.3}, interval of the mean {:.3}..{:.3}, {:.1} % below {:.3}",
+        t.mean,
+        t.mean_bounds.lo,
+        t.mean_bounds.hi,
+        100.0 * t.fraction_below,
+        t.epoch_bounds.lo
+    );
+    assert!(t.mean < t.mean_bounds.lo, "{}", t.mean);
+}
