@@ -82,6 +82,11 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         initial_errors: Default::default(),
         outage_test: None,
         baro: None,
+        // The navigation alone (the HTML report's cost is stated in the README).
+        report: schuler_cli::commands::aided_report::ReportSettings {
+            html: false,
+            ..Default::default()
+        },
     };
     (settings, aiding)
 }

@@ -22,43 +22,23 @@ fn vertical_max_in(nav: &Path, truth: &Path, from: f64, to: f64) -> f64 {
 #[test]
 fn a_barometer_holds_the_height_through_the_outage() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let sim = dir.path().join("sim");
-    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drive.toml");
-    assert_cmd::Command::cargo_bin("schuler")
-        .expect("binary")
-        .args(["simulate", "--config"])
-        .arg(&example)
-        .arg("--out")
-        .arg(&sim)
-        .assert()
-        .success();
-    let run = |name: &str, baro: bool| {
+    let sim = common::simulate_drive(dir.path());
+    let baro = sim.join("baro.csv");
+    let run = |name: &str, extra: &[&std::ffi::OsStr]| {
         let out = dir.path().join(name);
-        let mut c = assert_cmd::Command::cargo_bin("schuler").expect("binary");
-        c.args(["nav", "--imu"])
-            .arg(sim.join("imu.txt"))
-            .arg("--gnss")
-            .arg(sim.join("gnss.txt"))
-            .args(["--init-pos", "45.07,7.68,245", "--init-att", "0,0,10"])
-            .args([
-                "--lever-arm",
-                "0.5,0,-1",
-                "--imu-grade",
-                "tactical",
-                "--output-rate",
-                "10",
-                "--out",
-            ])
-            .arg(&out);
-        if baro {
-            c.arg("--baro")
-                .arg(sim.join("baro.csv"))
-                .args(["--baro-std", "0.5 m"]);
-        }
-        c.assert().success();
+        common::nav_drive(&sim, &out, extra).success();
         vertical_max_in(&out.join("nav.txt"), &sim.join("truth.nav"), 400.0, 460.0)
     };
-    let (without, with) = (run("gnss", false), run("baro", true));
+    let without = run("gnss", &[]);
+    let with = run(
+        "baro",
+        &[
+            "--baro".as_ref(),
+            baro.as_os_str(),
+            "--baro-std".as_ref(),
+            "0.5 m".as_ref(),
+        ],
+    );
     println!("vertical max in the outage: GNSS only {without:.3} m, with baro {with:.3} m");
     assert!(with < without, "{with} vs {without}");
     // The barometer's 0.5 m noise, averaged by the filter, with its bias estimated

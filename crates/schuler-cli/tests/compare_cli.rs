@@ -5,7 +5,8 @@
 //! distribution whose percentiles follow from their definition.
 
 use assert_cmd::Command;
-use schuler_cli::commands::compare::{EpochErrors, statistics};
+use schuler::analysis::errors::EpochErrors;
+use schuler::analysis::statistics::statistics;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 mod common;

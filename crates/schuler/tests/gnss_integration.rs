@@ -4,12 +4,14 @@
 //! errors are drawn per run from the tactical preset.
 
 use nalgebra::Vector3;
+use schuler::analysis::consistency::{ChiSquareTest, mean_bounds, normalized_squared};
+use schuler::analysis::errors::attitude_error;
 use schuler::earth::{EarthModel, Wgs84};
-use schuler::filter::integration::{GnssFix, IntegrationConfig, Integrator};
+use schuler::filter::integration::{GnssFix, Innovation, IntegrationConfig, Integrator};
+use schuler::filter::measurement::Kind;
 use schuler::filter::{Gate, ImuNoise};
 use schuler::imu::ImuSample;
 use schuler::nav::{LocalLevel, NavState};
-use schuler::rotation::rotation_vector_from_quaternion;
 use schuler::sim::analytic::Kinematics;
 use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::receivers::{BaroReading, GnssModel, GnssSimulator, Interval};
@@ -198,6 +200,8 @@ struct Epoch {
 
 struct Run {
     epochs: Vec<Epoch>,
+    /// Every measurement the filter tested.
+    innovations: Vec<Innovation>,
     /// Horizontal error of the smoothed trajectory at each second (with `smooth`).
     smoothed: Vec<(f64, f64)>,
     rejected: usize,
@@ -264,7 +268,7 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
             let c_en = schuler::earth::c_ne(truth.pos.lat, truth.pos.lon).transpose();
             let dr = c_en * (Wgs84.geodetic_to_ecef(&est.pos) - Wgs84.geodetic_to_ecef(&truth.pos));
             let dv = est.v_n - truth.v_n;
-            let psi = -rotation_vector_from_quaternion(&(est.q_bn * truth.q_bn.inverse()));
+            let psi = attitude_error(&est.q_bn, &truth.q_bn);
             let mut e = [0.0; 9];
             e[..3].copy_from_slice(dr.as_slice());
             e[3..6].copy_from_slice(dv.as_slice());
@@ -298,6 +302,7 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
         .collect();
     Run {
         epochs,
+        innovations: std::mem::take(&mut integ.innovations),
         smoothed,
         rejected: integ.rejected.len(),
         rejected_outliers,
@@ -316,19 +321,25 @@ fn in_outage(t: f64) -> bool {
 fn errors_meet_their_bounds_and_the_covariance_is_consistent() {
     let runs = 20;
     let mut nees_sum: Vec<f64> = Vec::new();
+    let mut nis: Vec<(Kind, f64)> = Vec::new();
     let mut worst_outage: f64 = 0.0;
     let mut worst_aided: f64 = 0.0;
     let mut worst_att: f64 = 0.0;
     for k in 0..runs {
         let (gnss, _) = fixes(100 + k, &[]);
         let r = run(200 + k, &gnss, &[]);
+        nis.extend(
+            r.innovations
+                .iter()
+                .filter(|i| i.accepted)
+                .map(|i| (i.kind, i.nis)),
+        );
         if nees_sum.is_empty() {
             nees_sum = vec![0.0; r.epochs.len()];
         }
         for (i, ep) in r.epochs.iter().enumerate() {
             let e = nalgebra::SVector::<f64, 9>::from_column_slice(&ep.e);
-            let nees = e.dot(&(ep.p.cholesky().expect("P > 0").solve(&e)));
-            nees_sum[i] += nees;
+            nees_sum[i] += normalized_squared(&e, &ep.p).expect("P > 0");
             if ep.t > 120.0 {
                 if in_outage(ep.t) {
                     worst_outage = worst_outage.max(horizontal(ep));
@@ -340,8 +351,10 @@ fn errors_meet_their_bounds_and_the_covariance_is_consistent() {
         }
     }
     let mean_nees: f64 = nees_sum.iter().sum::<f64>() / (nees_sum.len() * runs as usize) as f64;
-    // 95 % interval of the mean of 20 chi-square(9) draws: chi2(180) quantiles / 20.
-    let (lo, hi) = (144.35 / 20.0, 219.04 / 20.0);
+    // 95 % interval of the mean of 20 chi-square(9) draws: chi2(180) quantiles / 20
+    // (144.741 and 219.044, checked against mpmath in analysis::consistency).
+    let b = mean_bounds(runs as usize, 9, 0.95);
+    let (lo, hi) = (b.lo, b.hi);
     let inside = nees_sum
         .iter()
         .filter(|s| (lo..=hi).contains(&(*s / runs as f64)))
@@ -354,6 +367,33 @@ fn errors_meet_their_bounds_and_the_covariance_is_consistent() {
         worst_att
     );
     assert!((lo..=hi).contains(&mean_nees), "mean NEES {mean_nees}");
+    for kind in [Kind::GnssPosition, Kind::GnssVelocity] {
+        let t = ChiSquareTest::of(nis.iter().filter(|n| n.0 == kind).map(|n| n.1), 3, 0.95)
+            .expect("updates");
+        println!(
+            "{kind}: {} updates, mean NIS {:.3} (interval of the mean {:.3}..{:.3}), {:.2} % outside {:.3}..{:.3}",
+            t.count,
+            t.mean,
+            t.mean_bounds.lo,
+            t.mean_bounds.hi,
+            100.0 * t.fraction_outside(),
+            t.epoch_bounds.lo,
+            t.epoch_bounds.hi
+        );
+        // Innovations of a consistent filter are white: the average of N values of
+        // chi2(3) lies in chi2(3N)/N's 95 % interval.
+        assert!(t.mean_inside(), "{kind}: mean NIS {}", t.mean);
+        // Each update falls outside its 95 % interval with probability 0.05; over N
+        // independent updates the fraction outside has standard deviation
+        // sqrt(0.05 · 0.95 / N) (0.08 % for N = 69 000): 3.29 of them is the
+        // two-sided 99.9 % band.
+        let sd = (0.05 * 0.95 / t.count as f64).sqrt();
+        assert!(
+            (t.fraction_outside() - 0.05).abs() < 3.29 * sd,
+            "{kind}: {} outside",
+            t.fraction_outside()
+        );
+    }
     // With GNSS: the RTK noise's horizontal std is 0.028 m; the largest of 20 x 3500
     // epochs of a filtered estimate stays below ~5 of those.
     assert!(worst_aided < 0.15, "{worst_aided}");
@@ -460,4 +500,35 @@ fn a_barometer_holds_the_height_through_outages() {
     assert!(b < a, "{b} vs {a}");
     // Half a metre of baro noise averaged over the outage: well under a metre.
     assert!(b < 1.0, "{b}");
+}
+
+/// The NIS test has teeth: the same data with the receiver's standard deviations
+/// declared 3 times too large (a 9-fold R) gives position innovations whose NIS
+/// averages far below its 3 dof, outside the interval the consistent runs meet.
+#[test]
+fn a_mismatched_noise_model_fails_the_nis_test() {
+    let (mut gnss, _) = fixes(51, &[]);
+    for f in &mut gnss {
+        f.pos_std *= 3.0;
+        f.vel = f.vel.map(|(v, std)| (v, std * 3.0));
+    }
+    let r = run(52, &gnss, &[]);
+    let t = ChiSquareTest::of(
+        r.innovations
+            .iter()
+            .filter(|i| i.accepted && i.kind == Kind::GnssPosition)
+            .map(|i| i.nis),
+        3,
+        0.95,
+    )
+    .expect("updates");
+    println!(
+        "R 9x too large: mean position NIS {:.3}, interval of the mean {:.3}..{:.3}, {:.1} % below {:.3}",
+        t.mean,
+        t.mean_bounds.lo,
+        t.mean_bounds.hi,
+        100.0 * t.fraction_below,
+        t.epoch_bounds.lo
+    );
+    assert!(t.mean < t.mean_bounds.lo, "{}", t.mean);
 }

@@ -3,8 +3,11 @@
 //! `nav.csv` it writes, at the output rate, `std.txt` (standard deviations) and
 //! `imu_err.txt` (estimated sensor errors) in KF-GINS's column layouts, and at the end
 //! `rejected.csv` (every measurement the gate refused or that fell outside the IMU
-//! data, with time and reason).
+//! data, with time and reason) and `innovations.csv` (every measurement tested, with
+//! its innovation, predicted standard deviations and NIS; [`super::aided_record`]).
 
+use super::aided_record::RunRecorder;
+use super::aided_report::{ReportData, ReportSettings, RunFacts};
 use super::nav::{Decimator, MechanizationKind, NavSettings, NavSummary};
 use crate::output::{NavEpoch, NavWriter, push_fixed};
 use anyhow::{Context, Result, bail};
@@ -62,6 +65,8 @@ pub struct Aiding {
     pub outage_test: Option<OutageTest>,
     /// Barometer readings `(t, h)` and their noise standard deviation [m].
     pub baro: Option<(Vec<(f64, f64)>, f64)>,
+    /// The report: whether to write `report.html`, and the truths it compares with.
+    pub report: ReportSettings,
 }
 
 /// The outage test of `--outage-test`.
@@ -82,6 +87,8 @@ pub struct AidedSummary {
     pub counts: Counts,
     /// Mean normalized innovation squared per dimension of the accepted updates.
     pub mean_nis_per_dof: f64,
+    /// The consistency summary (and the report's path) to print.
+    pub report_text: String,
 }
 
 /// Text writer for `std.txt` and `imu_err.txt`.
@@ -316,11 +323,13 @@ where
     integ.prime(&first);
     let mut std = Table::create(&settings.out, aiding.names.std)?;
     let mut err = Table::create(&settings.out, aiding.names.imu_err)?;
+    let mut recorder = RunRecorder::create(&settings.out, aiding.report.truth_rows())?;
     let mut fixes = aiding.fixes.iter().copied().peekable();
     let mut decimator = Decimator::new(settings.output_rate);
     decimator.take(first.t, first.dt);
     integ.record_output();
     write_epoch(&integ, &earth, &mut writer, &mut std, &mut err)?;
+    recorder.after_sample(&mut integ, first.t, first.dt)?;
     let mut n = 0u64;
     let mut last_t = first.t;
     let mut failure = None;
@@ -344,6 +353,7 @@ where
                 next_baro += 1;
             }
         }
+        recorder.after_sample(&mut integ, s.t, s.dt)?;
         n += 1;
         last_t = s.t;
         if decimator.take(s.t, s.dt) {
@@ -360,6 +370,7 @@ where
     let epochs = writer.finish()?;
     std.finish()?;
     err.finish()?;
+    recorder.innovations.finish()?;
     write_rejections(&settings.out, &integ)?;
     if aiding.smooth {
         write_smoothed(
@@ -375,10 +386,32 @@ where
             settings.out.display()
         )));
     }
-    let (sum, dof) = integ
-        .nis
+    let (sum, dof) = recorder
+        .innovations
+        .rows
         .iter()
-        .fold((0.0, 0usize), |(s, d), (_, _, nis, k)| (s + nis, d + k));
+        .filter(|i| i.accepted)
+        .fold((0.0, 0usize), |(s, d), i| (s + i.nis, d + i.dof));
+    let report_text = super::aided_report::write(
+        &settings.out,
+        aiding.report.html,
+        &ReportData {
+            facts: RunFacts {
+                imu: &settings.imu,
+                nav_file: &settings.out.join(aiding.names.nav),
+                mechanization: M::KIND,
+                layout: integ.layout(),
+                samples: n,
+                t_first: first.t,
+                t_last: last_t,
+                counts: integ.counts,
+                gate_resets: integ.gate_resets.len(),
+                fixes: &aiding.fixes,
+            },
+            recorder: &recorder,
+            settings: &aiding.report,
+        },
+    )?;
     Ok(AidedSummary {
         nav: NavSummary {
             samples: n,
@@ -392,6 +425,7 @@ where
         },
         counts: integ.counts,
         mean_nis_per_dof: if dof > 0 { sum / dof as f64 } else { f64::NAN },
+        report_text,
     })
 }
 
@@ -486,9 +520,19 @@ pub struct AidingOptions {
     /// Start of the first test outage [s, the log's clock].
     #[arg(long, allow_hyphen_values = true, value_name = "SOW")]
     pub outage_start: Option<f64>,
-    /// Truth (KF-GINS navigation text or schuler CSV) for the outage test's report.
+    /// Truth (KF-GINS navigation text or schuler CSV): the report's position errors
+    /// and NEES, and the outage test's errors.
     #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub truth: Option<PathBuf>,
+    /// Truth of the sensor errors for the report, in imu_err.txt's layout (`t`, gyro
+    /// bias [deg/h], accelerometer bias [mGal], optionally scale factors [ppm]).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub sensor_truth: Option<PathBuf>,
+    /// Do not write report.html and report/ (innovations.csv and consistency.json are
+    /// always written).
+    #[arg(long)]
+    #[serde(default)]
+    pub no_report: bool,
     /// Longest covariance propagation step (default 1 s; the covariance is always
     /// propagated to each measurement's time).
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
@@ -499,7 +543,7 @@ impl AidingOptions {
     /// `self` with missing fields taken from `other`.
     pub fn or(self, other: AidingOptions) -> AidingOptions {
         macro_rules! pick {
-            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth } };
+            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth, no_report: self.no_report || other.no_report } };
         }
         pick!(
             gnss,
@@ -525,15 +569,21 @@ impl AidingOptions {
             outage_test,
             outage_start,
             truth,
+            sensor_truth,
             propagation_interval
         )
     }
 
     /// Paths relative to `base` (a config file's folder).
     pub fn relative_to(mut self, base: &Path) -> Self {
-        for p in [&mut self.gnss, &mut self.gnss_vel, &mut self.truth]
-            .into_iter()
-            .flatten()
+        for p in [
+            &mut self.gnss,
+            &mut self.gnss_vel,
+            &mut self.truth,
+            &mut self.sensor_truth,
+        ]
+        .into_iter()
+        .flatten()
         {
             if p.is_relative() {
                 *p = base.join(&*p);
@@ -664,9 +714,6 @@ impl AidingOptions {
                 })
             }
         };
-        if self.truth.is_some() && outage_test.is_none() {
-            bail!("--truth is used by --outage-test (use `schuler compare` to compare any result)");
-        }
         let mut baro_cfg = None;
         let baro_readings = match &self.baro {
             None => None,
@@ -714,6 +761,17 @@ impl AidingOptions {
             initial_errors: Default::default(),
             outage_test,
             baro: baro_readings,
+            report: ReportSettings {
+                html: !self.no_report,
+                truth: match &self.truth {
+                    Some(p) => Some((p.clone(), crate::formats::nav::read_nav(p)?.1)),
+                    None => None,
+                },
+                sensor_truth: match &self.sensor_truth {
+                    Some(p) => crate::formats::sensor_errors::read_sensor_errors(p)?,
+                    None => Vec::new(),
+                },
+            },
             fixes,
             config: IntegrationConfig {
                 noise,
@@ -754,9 +812,9 @@ pub fn report_outage_test(
         println!("  (give --truth FILE for the errors in each outage)");
         return Ok(());
     };
-    let (_, nav_rows) = super::compare::read_nav(nav)?;
-    let (_, truth_rows) = super::compare::read_nav(truth)?;
-    let c = super::compare::compare(&nav_rows, &truth_rows, None, None, windows)?;
+    let (_, nav_rows) = crate::formats::nav::read_nav(nav)?;
+    let (_, truth_rows) = crate::formats::nav::read_nav(truth)?;
+    let c = schuler::analysis::statistics::compare(&nav_rows, &truth_rows, None, None, windows)?;
     let mut json = Vec::new();
     println!(
         "  outage [s]          | horizontal max [m] | vertical max [m] | roll/pitch/yaw max [deg]"

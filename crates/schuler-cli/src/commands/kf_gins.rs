@@ -192,6 +192,7 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         names: OutputNames::KF_GINS,
         outage_test: None,
         baro: None,
+        report: super::aided_report::ReportSettings::default(),
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
             accel_bias: Vector3::from(y.initaccbias) * MGAL,
@@ -235,5 +236,6 @@ pub fn run(path: &Path) -> Result<()> {
         summary.nav.epochs,
         settings.out.join(aiding.names.nav).display()
     );
+    print!("{}", summary.report_text);
     Ok(())
 }

@@ -2,6 +2,8 @@
 //! calls to readers and writers.
 
 pub mod aided;
+pub mod aided_record;
+pub mod aided_report;
 pub mod align;
 pub mod channel;
 pub mod compare;

@@ -918,6 +918,7 @@ pub fn run(args: NavArgs) -> Result<()> {
             c.skipped,
             summary.mean_nis_per_dof
         );
+        print!("{}", summary.report_text);
         if let Some(test) = &aiding.outage_test {
             super::aided::report_outage_test(
                 &settings.out.join("nav.txt"),

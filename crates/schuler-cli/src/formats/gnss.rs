@@ -17,7 +17,7 @@ const VEL_FIELDS: [&str; 7] = ["time", "vn", "ve", "vd", "std_vn", "std_ve", "st
 
 /// Numbers of each data line (blank lines and `#`/`%` comments skipped), with their
 /// 1-based line numbers; checks column counts, finiteness and increasing time.
-fn numeric_rows(
+pub(crate) fn numeric_rows(
     path: &Path,
     names: &[&str],
     counts: &[usize],

@@ -9,6 +9,8 @@ pub mod error;
 pub mod gnss;
 pub mod imu_log;
 mod lines;
+pub mod nav;
+pub mod sensor_errors;
 
 pub use error::InputError;
 pub use imu_log::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};

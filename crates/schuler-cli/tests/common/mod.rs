@@ -41,3 +41,44 @@ pub fn rows(text: &str) -> Vec<Vec<f64>> {
 pub fn read_rows(path: &Path) -> Vec<Vec<f64>> {
     rows(&std::fs::read_to_string(path).expect("read"))
 }
+
+/// `schuler simulate` of the example drive (`examples/drive.toml`: 20 minutes, a
+/// tactical IMU at 200 Hz, GNSS at 1 Hz with a lever arm and a 60-s outage at
+/// 400-460 s, a barometer with a 3-m bias) into `dir/sim`.
+pub fn simulate_drive(dir: &Path) -> PathBuf {
+    let sim = dir.join("sim");
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drive.toml");
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["simulate", "--config"])
+        .arg(&example)
+        .arg("--out")
+        .arg(&sim)
+        .assert()
+        .success();
+    sim
+}
+
+/// `schuler nav --gnss` of the simulated drive into `out` (its initial state, lever
+/// arm and IMU grade, 10-Hz output), with `extra` flags.
+pub fn nav_drive(sim: &Path, out: &Path, extra: &[&std::ffi::OsStr]) -> assert_cmd::assert::Assert {
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--imu"])
+        .arg(sim.join("imu.txt"))
+        .arg("--gnss")
+        .arg(sim.join("gnss.txt"))
+        .args(["--init-pos", "45.07,7.68,245", "--init-att", "0,0,10"])
+        .args([
+            "--lever-arm",
+            "0.5,0,-1",
+            "--imu-grade",
+            "tactical",
+            "--output-rate",
+            "10",
+        ])
+        .args(extra)
+        .arg("--out")
+        .arg(out)
+        .assert()
+}

@@ -1,3 +1,11 @@
 //! Error statistics and sensor characterization.
+//!
+//! - [`errors`]: a navigation result's errors against a truth, epoch by epoch;
+//! - [`statistics`]: RMS, maximum, 95th percentile, CEP and per-outage maxima;
+//! - [`consistency`]: NIS and NEES against their chi-square bounds;
+//! - [`allan`]: Allan deviation.
 
 pub mod allan;
+pub mod consistency;
+pub mod errors;
+pub mod statistics;

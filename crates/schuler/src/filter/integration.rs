@@ -19,7 +19,7 @@ use super::noise::ImuNoise;
 use crate::earth::{EarthModel, Geodetic};
 use crate::imu::ImuSample;
 use crate::nav::{ErrorFrame, NavErrors, NavState};
-use nalgebra::{DMatrix, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// One GNSS epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,7 +67,7 @@ pub struct IntegrationConfig {
 }
 
 /// A measurement the gate refused.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Rejected {
     /// Time [s].
     pub t: f64,
@@ -75,6 +75,27 @@ pub struct Rejected {
     pub kind: Kind,
     /// Why: the test's numbers.
     pub rejection: Rejection,
+}
+
+/// One measurement as the filter tested it, accepted or refused: the innovation
+/// `z` (computed minus measured, in the computation frame `c` of
+/// [`crate::filter::measurement`]; NED on the local-level mechanization), the diagonal
+/// of its covariance `S = H P Hᵀ + R` and the normalized innovation squared
+/// `zᵀ S⁻¹ z`, chi-square with `z.len()` degrees of freedom for a consistent filter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Innovation {
+    /// Time [s].
+    pub t: f64,
+    /// What it was.
+    pub kind: Kind,
+    /// Innovation (units of the measurement: m, m/s).
+    pub z: DVector<f64>,
+    /// Diagonal of the innovation covariance `S` (units squared).
+    pub s_diag: DVector<f64>,
+    /// Normalized innovation squared (infinite when `S` is not positive definite).
+    pub nis: f64,
+    /// Whether the gate let it through.
+    pub accepted: bool,
 }
 
 /// A measurement that could not be used at all.
@@ -152,8 +173,9 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     pub rejected: Vec<Rejected>,
     /// Measurements outside the IMU span, in time order.
     pub skipped: Vec<Skipped>,
-    /// Normalized innovations of accepted updates: time, kind, NIS, dimension.
-    pub nis: Vec<(f64, Kind, f64, usize)>,
+    /// Every measurement tested, in time order (take it with `std::mem::take` now
+    /// and then to bound memory on long runs).
+    pub innovations: Vec<Innovation>,
     /// Counters.
     pub counts: Counts,
     /// Times at which the gate was bypassed after `reset_after` refusals in a row.
@@ -227,7 +249,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             w_ib_b: Vector3::zeros(),
             rejected: Vec::new(),
             skipped: Vec::new(),
-            nis: Vec::new(),
+            innovations: Vec::new(),
             counts: Counts::default(),
             gate_resets: Vec::new(),
             consecutive_rejections: 0,
@@ -290,18 +312,21 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         &self.kf.p
     }
 
-    /// Standard deviations of position and velocity in NED and of the attitude error
-    /// about north, east, down, from the covariance.
-    pub fn nav_std(&self) -> [Vector3<f64>; 3] {
+    /// Covariances of the position and velocity errors in NED and of the attitude
+    /// error about north, east, down: `C_cn P_c C_nc` of each 3x3 block.
+    pub fn nav_covariance(&self) -> [Matrix3<f64>; 3] {
         let frame = self.mech.frame();
         let c = measurement::c_nc(&frame, &self.mech.state().pos).transpose();
         let p = &self.kf.p;
-        let ned = |o: usize| {
-            (c * block(p, o) * c.transpose())
-                .diagonal()
-                .map(|v| v.max(0.0).sqrt())
-        };
+        let ned = |o: usize| c * block(p, o) * c.transpose();
         [ned(Layout::POS), ned(Layout::VEL), ned(Layout::ATT)]
+    }
+
+    /// Standard deviations of position and velocity in NED and of the attitude error
+    /// about north, east, down, from the covariance.
+    pub fn nav_std(&self) -> [Vector3<f64>; 3] {
+        self.nav_covariance()
+            .map(|p| p.diagonal().map(|v| v.max(0.0).sqrt()))
     }
 
     /// Prime the two-sample corrections with the sample that ends at the start.
@@ -416,14 +441,28 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
     }
 
-    /// Gate a measurement and, if accepted, update and feed back.
+    /// Gate a measurement, record it in [`Integrator::innovations`] and, if
+    /// accepted, update and feed back.
     pub fn apply(&mut self, t: f64, m: Measurement) -> bool {
         let position = m.kind == Kind::GnssPosition;
         let reset = position
             && self.cfg.reset_after > 0
             && self.consecutive_rejections >= self.cfg.reset_after;
         let gate = if reset { Gate::Off } else { self.cfg.gate };
-        match self.kf.update(&m.z, &m.h, &m.r, gate) {
+        let outcome = self.kf.update(&m.z, &m.h, &m.r, gate);
+        let (nis, s_diag) = match &outcome {
+            Ok(u) => (u.nis, &u.s_diag),
+            Err(r) => (r.nis, &r.s_diag),
+        };
+        self.innovations.push(Innovation {
+            t,
+            kind: m.kind,
+            z: m.z,
+            s_diag: s_diag.clone(),
+            nis,
+            accepted: outcome.is_ok(),
+        });
+        match outcome {
             Ok(u) => {
                 if reset {
                     self.gate_resets.push(t);
@@ -431,7 +470,6 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
                 if position {
                     self.consecutive_rejections = 0;
                 }
-                self.nis.push((t, m.kind, u.nis, m.z.len()));
                 match m.kind {
                     Kind::GnssPosition => self.counts.position += 1,
                     Kind::GnssVelocity => self.counts.velocity += 1,

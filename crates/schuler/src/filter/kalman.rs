@@ -27,16 +27,20 @@ pub struct Update {
     pub dx: DVector<f64>,
     /// Normalized innovation squared `zᵀ S⁻¹ z`.
     pub nis: f64,
+    /// Diagonal of the innovation covariance `S = H P Hᵀ + R`.
+    pub s_diag: DVector<f64>,
 }
 
 /// A rejected measurement and why.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Rejection {
     /// Normalized innovation squared.
     pub nis: f64,
     /// The gate's threshold for this dimension (infinite when the innovation
     /// covariance is not positive definite).
     pub threshold: f64,
+    /// Diagonal of the innovation covariance `S = H P Hᵀ + R`.
+    pub s_diag: DVector<f64>,
 }
 
 /// The error covariance.
@@ -85,10 +89,12 @@ impl Kalman {
     ) -> Result<Update, Rejection> {
         let pht = &self.p * h.transpose();
         let s = h * &pht + r;
-        let Some(chol) = s.clone().cholesky() else {
+        let s_diag = s.diagonal();
+        let Some(chol) = s.cholesky() else {
             return Err(Rejection {
                 nis: f64::INFINITY,
                 threshold: f64::INFINITY,
+                s_diag,
             });
         };
         let s_inv_z = chol.solve(z);
@@ -96,7 +102,11 @@ impl Kalman {
         if let Gate::Level(alpha) = gate {
             let threshold = chi_square_quantile(z.len(), 1.0 - alpha);
             if nis > threshold || !nis.is_finite() {
-                return Err(Rejection { nis, threshold });
+                return Err(Rejection {
+                    nis,
+                    threshold,
+                    s_diag,
+                });
             }
         }
         // K = P Hᵀ S⁻¹ (S symmetric): solve S Kᵀ = H P.
@@ -106,7 +116,7 @@ impl Kalman {
         let ikh = DMatrix::identity(n, n) - &k * h;
         let p = &ikh * &self.p * ikh.transpose() + &k * r * k.transpose();
         self.p = (&p + p.transpose()) * 0.5;
-        Ok(Update { dx, nis })
+        Ok(Update { dx, nis, s_diag })
     }
 }
 
@@ -287,6 +297,7 @@ mod tests {
         assert!((u.dx[0] - 2.4).abs() < 1e-15);
         assert!((kf.p[(0, 0)] - 0.8).abs() < 1e-15);
         assert!((u.nis - 1.8).abs() < 1e-15);
+        assert_eq!(u.s_diag.as_slice(), [5.0]);
     }
 
     #[test]
@@ -301,6 +312,7 @@ mod tests {
         let rej = r.unwrap_err();
         assert!((rej.nis - 50.0).abs() < 1e-12);
         assert!((rej.threshold - 10.828).abs() < 1e-3);
+        assert_eq!(rej.s_diag.as_slice(), [2.0]);
         assert_eq!(kf.p[(0, 0)], 1.0);
     }
 }

@@ -28,6 +28,16 @@ pub enum Kind {
     BaroHeight,
 }
 
+impl Kind {
+    /// Unit of the innovation's components, for reports: `m`, `m/s`.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Kind::GnssPosition | Kind::BaroHeight => "m",
+            Kind::GnssVelocity => "m/s",
+        }
+    }
+}
+
 impl std::fmt::Display for Kind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {

@@ -1,0 +1,1027 @@
+//! The aided run's consistency report and `report.html`.
+//!
+//! After `schuler nav --gnss ...` has written its results:
+//! - `consistency.json` (always) and a few printed lines: per measurement kind the NIS
+//!   of the accepted measurements against chi-square (per-update 95 % interval, the
+//!   average's interval from `chi2(N dof)`, the fraction outside), and with `--truth`
+//!   the NEES of position, velocity and attitude (3 dof each) sampled once a second
+//!   ([`schuler::analysis::consistency`]);
+//! - unless `--no-report`, `report.html` (one self-contained file,
+//!   [`crate::report::Report`]) and `report/`, the SVG plots and CSV data behind
+//!   them: position error against the truth (the seed's circular error dS and the
+//!   vertical error, GNSS gaps shaded, the statistics of `schuler compare`), the
+//!   estimated sensor errors with ±3σ bounds (with `--sensor-truth`, their truth),
+//!   innovations with ±3σ of their predicted covariance, NIS and NEES with their
+//!   bounds, and the accepted and refused measurements per kind.
+//!
+//! NIS is tested over the accepted measurements: the refused ones are outliers by the
+//! filter's own test, counted apart (including them would let one 50-m jump dominate
+//! the mean). Successive NEES values of one run are correlated (the error drifts
+//! slowly), so the interval of their average, which assumes independence, is
+//! narrower than a single run's spread; the Monte-Carlo test in the library
+//! (`tests/gnss_integration.rs`) is the sharp one.
+
+use super::aided_record::{InnovationRow, ReportSample, RunRecorder};
+use super::nav::MechanizationKind;
+use crate::plot::{LineStyle, Plot};
+use crate::report::{Report, Table};
+use anyhow::{Context, Result};
+use schuler::analysis::consistency::ChiSquareTest;
+use schuler::analysis::errors::NavRecord;
+use schuler::analysis::statistics::{Comparison, QUANTITIES, compare};
+use schuler::filter::integration::Counts;
+use schuler::filter::measurement::Kind;
+use schuler::filter::{GnssFix, Layout, SensorEstimates};
+use schuler::units::{DEG_PER_H, MGAL, PPM};
+use serde_json::{Value, json};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Probability of every chi-square interval in the report.
+pub const PROBABILITY: f64 = 0.95;
+
+/// What the report is given beyond the run (`--no-report`, `--truth`,
+/// `--sensor-truth`), the files read and checked before the run starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportSettings {
+    /// Write `report.html` and `report/`.
+    pub html: bool,
+    /// Navigation truth (KF-GINS text or nav.csv), for errors and NEES: its path and
+    /// epochs in time order.
+    pub truth: Option<(PathBuf, Vec<NavRecord>)>,
+    /// Sensor-error truth (`imu_err.txt`'s layout), in time order; empty: none.
+    pub sensor_truth: Vec<(f64, SensorEstimates)>,
+}
+
+impl Default for ReportSettings {
+    fn default() -> Self {
+        Self {
+            html: true,
+            truth: None,
+            sensor_truth: Vec::new(),
+        }
+    }
+}
+
+impl ReportSettings {
+    /// The truth's epochs (empty without one).
+    pub fn truth_rows(&self) -> &[NavRecord] {
+        self.truth.as_ref().map_or(&[], |t| &t.1)
+    }
+}
+
+/// Facts of the run the report states.
+#[derive(Debug, Clone, Copy)]
+pub struct RunFacts<'a> {
+    /// The IMU log.
+    pub imu: &'a Path,
+    /// The navigation result written (forward filter).
+    pub nav_file: &'a Path,
+    /// Mechanization the filter ran on.
+    pub mechanization: MechanizationKind,
+    /// The filter's states.
+    pub layout: Layout,
+    /// IMU samples integrated.
+    pub samples: u64,
+    /// First time [s].
+    pub t_first: f64,
+    /// Last time [s].
+    pub t_last: f64,
+    /// Filter counters.
+    pub counts: Counts,
+    /// Times the gate was bypassed after consecutive refusals.
+    pub gate_resets: usize,
+    /// The GNSS fixes used (after any test outages were cut out).
+    pub fixes: &'a [GnssFix],
+}
+
+/// The NIS test of one measurement kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KindConsistency {
+    /// The kind.
+    pub kind: Kind,
+    /// Its dimension.
+    pub dof: usize,
+    /// Measurements accepted by the gate.
+    pub accepted: usize,
+    /// Measurements refused.
+    pub refused: usize,
+    /// The test of the accepted ones' NIS (`None` without any).
+    pub test: Option<ChiSquareTest>,
+}
+
+/// NIS per kind, in order of first appearance.
+pub fn nis_by_kind(rows: &[InnovationRow]) -> Vec<KindConsistency> {
+    let mut kinds: Vec<(Kind, usize)> = Vec::new();
+    for r in rows {
+        if !kinds.iter().any(|k| k.0 == r.kind) {
+            kinds.push((r.kind, r.dof));
+        }
+    }
+    kinds
+        .into_iter()
+        .map(|(kind, dof)| {
+            let of_kind = || rows.iter().filter(move |r| r.kind == kind);
+            let accepted = of_kind().filter(|r| r.accepted).count();
+            KindConsistency {
+                kind,
+                dof,
+                accepted,
+                refused: of_kind().count() - accepted,
+                test: ChiSquareTest::of(
+                    of_kind().filter(|r| r.accepted).map(|r| r.nis),
+                    dof,
+                    PROBABILITY,
+                ),
+            }
+        })
+        .collect()
+}
+
+/// Names of the NEES blocks, in [`ReportSample::nees`] order.
+pub const NEES_BLOCKS: [&str; 3] = ["position", "velocity", "attitude"];
+
+/// NEES tests of position, velocity and attitude over the samples that have one.
+pub fn nees_tests(samples: &[ReportSample]) -> [Option<ChiSquareTest>; 3] {
+    std::array::from_fn(|k| {
+        ChiSquareTest::of(
+            samples
+                .iter()
+                .filter_map(|s| s.nees.map(|n| n[k].unwrap_or(f64::INFINITY))),
+            3,
+            PROBABILITY,
+        )
+    })
+}
+
+fn test_json(t: &ChiSquareTest) -> Value {
+    json!({
+        "dof": t.dof, "count": t.count, "non_finite": t.non_finite, "mean": t.mean,
+        "epoch_interval": [t.epoch_bounds.lo, t.epoch_bounds.hi],
+        "mean_interval": [t.mean_bounds.lo, t.mean_bounds.hi],
+        "mean_inside": t.mean_inside(),
+        "fraction_below": t.fraction_below, "fraction_above": t.fraction_above,
+        "fraction_outside": t.fraction_outside(),
+    })
+}
+
+/// `consistency.json`: NIS per kind and, with a truth, NEES.
+pub fn consistency_json(
+    nis: &[KindConsistency],
+    nees: Option<&[Option<ChiSquareTest>; 3]>,
+) -> Value {
+    let nis: Vec<Value> = nis
+        .iter()
+        .map(|k| {
+            json!({
+                "kind": k.kind.to_string(), "dof": k.dof,
+                "accepted": k.accepted, "refused": k.refused,
+                "test": k.test.as_ref().map(test_json),
+            })
+        })
+        .collect();
+    let nees = nees.map(|tests| {
+        let mut m = serde_json::Map::new();
+        m.insert("sampling_s".to_owned(), json!(1.0));
+        m.insert(
+            "note".to_owned(),
+            json!(
+                "successive epochs are correlated: the mean's interval assumes independent epochs"
+            ),
+        );
+        for (name, t) in NEES_BLOCKS.iter().zip(tests) {
+            m.insert(
+                (*name).to_owned(),
+                t.as_ref().map_or(Value::Null, test_json),
+            );
+        }
+        Value::Object(m)
+    });
+    json!({
+        "probability": PROBABILITY,
+        "nis_over": "accepted measurements",
+        "nis": nis,
+        "nees": nees,
+    })
+}
+
+fn test_line(t: &ChiSquareTest) -> String {
+    format!(
+        "mean {:.3} {} [{:.3}, {:.3}]; {:.1} % outside [{:.3}, {:.3}]",
+        t.mean,
+        if t.mean_inside() { "in" } else { "NOT in" },
+        t.mean_bounds.lo,
+        t.mean_bounds.hi,
+        100.0 * t.fraction_outside(),
+        t.epoch_bounds.lo,
+        t.epoch_bounds.hi
+    )
+}
+
+/// The printed consistency summary.
+pub fn consistency_text(
+    nis: &[KindConsistency],
+    nees: Option<&[Option<ChiSquareTest>; 3]>,
+) -> String {
+    let mut s = format!(
+        "consistency ({:.0} % chi-square intervals; consistency.json):\n",
+        100.0 * PROBABILITY
+    );
+    for k in nis {
+        let _ = write!(s, "  NIS  {:<14} {} dof: ", k.kind.to_string(), k.dof);
+        match &k.test {
+            Some(t) => s.push_str(&test_line(t)),
+            None => s.push_str("no accepted measurement"),
+        }
+        let _ = writeln!(s, "; {} accepted, {} refused", k.accepted, k.refused);
+    }
+    if let Some(tests) = nees {
+        for (name, t) in NEES_BLOCKS.iter().zip(tests) {
+            let _ = write!(s, "  NEES {name:<14} 3 dof: ");
+            match t {
+                Some(t) => {
+                    let _ = writeln!(s, "{} ({} epochs at 1 Hz)", test_line(t), t.count);
+                }
+                None => s.push_str("no epoch inside the truth's span\n"),
+            }
+        }
+    }
+    s
+}
+
+/// GNSS gaps: intervals between consecutive fixes more than twice the median spacing
+/// apart (outages, given or cut by `--outage-test`).
+pub fn gnss_gaps(fixes: &[GnssFix]) -> Vec<(f64, f64)> {
+    if fixes.len() < 3 {
+        return Vec::new();
+    }
+    let mut dt: Vec<f64> = fixes.windows(2).map(|w| w[1].t - w[0].t).collect();
+    dt.sort_unstable_by(f64::total_cmp);
+    let median = dt[dt.len() / 2];
+    fixes
+        .windows(2)
+        .filter(|w| w[1].t - w[0].t > 2.0 * median)
+        .map(|w| (w[0].t, w[1].t))
+        .collect()
+}
+
+/// `(t, y)` with a NaN point inserted before each step in `t` longer than twice the
+/// median step, so that a plotted line breaks across data gaps instead of bridging
+/// them.
+fn gapped(t: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    dt.sort_unstable_by(f64::total_cmp);
+    let limit = dt.get(dt.len() / 2).map_or(f64::INFINITY, |m| 2.0 * m);
+    let mut out = (Vec::with_capacity(t.len()), Vec::with_capacity(y.len()));
+    for (k, (&ti, &yi)) in t.iter().zip(y).enumerate() {
+        if k > 0 && ti - t[k - 1] > limit {
+            out.0.push(f64::NAN);
+            out.1.push(f64::NAN);
+        }
+        out.0.push(ti);
+        out.1.push(yi);
+    }
+    out
+}
+
+/// A series plus its ±`k`·σ envelope about `center` (a zero `center`: about zero),
+/// as two lines: the series, and the envelope drawn as one series (upper, a break,
+/// lower) so both bounds share a colour and a legend entry; lines break at gaps.
+fn with_envelope(
+    plot: Plot,
+    (name, band): (&str, &str),
+    t: &[f64],
+    y: &[f64],
+    center: &[f64],
+    sigma3: &[f64],
+) -> Plot {
+    let (x, y) = gapped(t, y);
+    let up: Vec<f64> = center.iter().zip(sigma3).map(|(c, s)| c + s).collect();
+    let down: Vec<f64> = center.iter().zip(sigma3).map(|(c, s)| c - s).collect();
+    let (xu, mut yu) = gapped(t, &up);
+    let (xd, yd) = gapped(t, &down);
+    let mut xb = xu;
+    xb.push(f64::NAN);
+    xb.extend(xd);
+    yu.push(f64::NAN);
+    yu.extend(yd);
+    plot.line(name, &x, &y, LineStyle::Solid)
+        .line(band, &xb, &yu, LineStyle::Dashed)
+}
+
+/// What every section needs: where plots and CSVs go (`OUT/report/`), the run's
+/// data, and the GNSS gaps to shade.
+struct Ctx<'a> {
+    dir: PathBuf,
+    data: &'a ReportData<'a>,
+    gaps: Vec<(f64, f64)>,
+}
+
+/// The time axis of every plot.
+const T_LABEL: &str = "t − t0 [s]";
+
+impl Ctx<'_> {
+    /// Time from the run's start [s].
+    fn rel(&self, t: f64) -> f64 {
+        t - self.data.facts.t_first
+    }
+
+    /// The plot with the GNSS gaps shaded.
+    fn shade(&self, p: Plot) -> Plot {
+        if self.gaps.is_empty() {
+            p
+        } else {
+            p.shade(
+                "GNSS gap",
+                self.gaps.iter().map(|&(a, b)| (self.rel(a), self.rel(b))),
+            )
+        }
+    }
+
+    fn svg(&self, name: &str, plot: &Plot) -> Result<String> {
+        plot.write(&self.dir.join(format!("{name}.svg")))?;
+        Ok(format!("report/{name}.svg"))
+    }
+
+    /// A CSV with a header and one row per item, numbers shortest round-trip, `None`
+    /// empty.
+    fn csv(
+        &self,
+        name: &str,
+        header: &str,
+        rows: impl Iterator<Item = Vec<Option<f64>>>,
+    ) -> Result<String> {
+        let path = self.dir.join(name);
+        let mut s = String::with_capacity(1 << 16);
+        s.push_str(header);
+        s.push('\n');
+        for row in rows {
+            for (k, v) in row.iter().enumerate() {
+                if k > 0 {
+                    s.push(',');
+                }
+                if let Some(v) = v {
+                    let _ = write!(s, "{v}");
+                }
+            }
+            s.push('\n');
+        }
+        std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(format!("report/{name}"))
+    }
+}
+
+/// Everything the report is built from.
+pub struct ReportData<'a> {
+    /// The run.
+    pub facts: RunFacts<'a>,
+    /// What the recorder kept.
+    pub recorder: &'a RunRecorder<'a>,
+    /// The truths.
+    pub settings: &'a ReportSettings,
+}
+
+/// Writes `consistency.json` and, if `html`, `report.html` with `report/`; returns
+/// the text to print.
+pub fn write(out: &Path, html: bool, data: &ReportData) -> Result<String> {
+    let nis = nis_by_kind(&data.recorder.innovations.rows);
+    let has_truth = data.settings.truth.is_some();
+    let nees = has_truth.then(|| nees_tests(&data.recorder.samples));
+    let path = out.join("consistency.json");
+    let text = serde_json::to_string_pretty(&consistency_json(&nis, nees.as_ref()))?;
+    std::fs::write(&path, text + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    let mut printed = consistency_text(&nis, nees.as_ref());
+    if html {
+        let ctx = Ctx {
+            dir: out.join("report"),
+            data,
+            gaps: gnss_gaps(data.facts.fixes),
+        };
+        std::fs::create_dir_all(&ctx.dir)
+            .with_context(|| format!("cannot create {}", ctx.dir.display()))?;
+        let report = build(&ctx, &nis, nees.as_ref())?;
+        let missing = report.plots_missing_units();
+        debug_assert!(missing.is_empty(), "plots without units: {missing:?}");
+        report.write(&out.join("report.html"))?;
+        let _ = writeln!(printed, "report: {}", out.join("report.html").display());
+    }
+    Ok(printed)
+}
+
+fn f3(x: f64) -> String {
+    format!("{x:.3}")
+}
+
+/// Builds the report, writing each plot's SVG and CSV.
+fn build(
+    c: &Ctx,
+    nis: &[KindConsistency],
+    nees: Option<&[Option<ChiSquareTest>; 3]>,
+) -> Result<Report> {
+    let f = &c.data.facts;
+    let gaps = &c.gaps;
+    let mut r = Report::new("schuler nav: INS/GNSS integration");
+    r.paragraph(&format!(
+        "IMU log {}: {} samples from t0 = {} s to {} s ({:.1} s), {} mechanization, \
+         {} filter states; {} GNSS fixes, {} gaps longer than twice their spacing \
+         (shaded in the plots). Times in the plots are counted from t0.",
+        f.imu.display(),
+        f.samples,
+        f.t_first,
+        f.t_last,
+        f.t_last - f.t_first,
+        f.mechanization,
+        f.layout.n,
+        f.fixes.len(),
+        gaps.len()
+    ));
+
+    // Measurements: counts per kind.
+    let s = r.section("measurements", "Measurements accepted and refused");
+    let mut table = Table::new(["measurement", "dof", "accepted", "refused by the gate"]);
+    for k in nis {
+        table = table.row([
+            k.kind.to_string(),
+            k.dof.to_string(),
+            k.accepted.to_string(),
+            k.refused.to_string(),
+        ]);
+    }
+    s.table(table.caption(
+        "Measurements the filter tested (innovations.csv; refusals with reasons in rejected.csv)",
+    ));
+    s.paragraph(&format!(
+        "{} GNSS fixes fell outside the IMU data and were not used; the gate was bypassed \
+         {} times after consecutive refusals (filter reset).",
+        f.counts.skipped, f.gate_resets
+    ));
+
+    position_section(&mut r, c)?;
+    sensor_section(&mut r, c)?;
+    innovation_section(&mut r, c)?;
+    nis_section(&mut r, c, nis)?;
+    if let Some(nees) = nees {
+        nees_section(&mut r, c, nees)?;
+    }
+    let s = r.section("files", "Files");
+    s.paragraph(&format!(
+        "In {}: the navigation result, std.txt (standard deviations), imu_err.txt \
+         (estimated sensor errors), rejected.csv, innovations.csv, consistency.json, this \
+         report, and report/ with every plot as SVG and the CSV behind it.",
+        f.nav_file
+            .parent()
+            .map_or_else(String::new, |p| p.display().to_string())
+    ));
+    Ok(r)
+}
+
+/// One column of `sensor_errors.csv`.
+type Column = Box<dyn Fn(&ReportSample) -> f64>;
+
+fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
+    let data = c.data;
+    let s = r.section("position", "Position error against the truth");
+    let Some((truth_path, truth)) = &data.settings.truth else {
+        s.paragraph("No truth given (--truth FILE, KF-GINS navigation text or nav.csv).");
+        return Ok(());
+    };
+    let (_, nav) = crate::formats::nav::read_nav(data.facts.nav_file)?;
+    let cmp: Comparison = compare(&nav, truth, None, None, &c.gaps).with_context(|| {
+        format!(
+            "comparing {} with {}",
+            data.facts.nav_file.display(),
+            truth_path.display()
+        )
+    })?;
+    s.paragraph(&format!(
+        "{} epochs of {} against {} ({} exact, {} with the truth interpolated). \
+         Horizontal is the seed's circular error dS = sqrt(dN² + dE²); vertical dD is \
+         positive down. Statistics as `schuler compare` gives them: 95 % is the \
+         nearest-rank percentile of |e|, CEP the median of dS.",
+        cmp.matching.matched(),
+        data.facts.nav_file.display(),
+        truth_path.display(),
+        cmp.matching.exact,
+        cmp.matching.interpolated
+    ));
+    let mut table = Table::new([
+        "error",
+        "unit",
+        "RMS",
+        "max |e|",
+        "at t − t0 [s]",
+        "95 % |e|",
+        "mean",
+    ]);
+    for (q, sm) in QUANTITIES.iter().zip(&cmp.stats.summaries) {
+        table = table.row([
+            q.name.to_owned(),
+            q.unit.to_owned(),
+            format!("{:.4}", sm.rms),
+            format!("{:.4}", sm.max_abs),
+            format!("{:.1}", c.rel(sm.t_max_sow)),
+            format!("{:.4}", sm.p95_abs),
+            format!("{:.4}", sm.mean),
+        ]);
+    }
+    s.table(table.caption(&format!(
+        "Errors over the run; CEP {:.4} m, CEP95 {:.4} m",
+        cmp.stats.cep, cmp.stats.cep95
+    )));
+    let with: Vec<_> = cmp.stats.outages.iter().filter(|o| o.epochs > 0).collect();
+    if !with.is_empty() {
+        let mut t = Table::new([
+            "GNSS gap, t − t0 [s]",
+            "epochs",
+            "max dS [m]",
+            "max |dD| [m]",
+            "max |yaw| [deg]",
+        ]);
+        for o in &with {
+            t = t.row([
+                format!("{:.1}–{:.1}", c.rel(o.from_sow), c.rel(o.to_sow)),
+                o.epochs.to_string(),
+                format!("{:.3}", o.horizontal),
+                format!("{:.3}", o.vertical),
+                format!("{:.4}", o.att.yaw.to_degrees()),
+            ]);
+        }
+        if let Some(rms) = &cmp.stats.outage_rms {
+            t = t.row([
+                "RMS of the maxima".to_owned(),
+                rms.epochs.to_string(),
+                format!("{:.3}", rms.horizontal),
+                format!("{:.3}", rms.vertical),
+                format!("{:.4}", rms.att.yaw.to_degrees()),
+            ]);
+        }
+        s.table(t.caption("Largest errors inside each GNSS gap (INS bridging)"));
+    }
+    super::compare::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
+    let t: Vec<f64> = cmp.errors.iter().map(|e| c.rel(e.t_sow)).collect();
+    let ds: Vec<f64> = cmp.errors.iter().map(|e| e.horizontal()).collect();
+    let dd: Vec<f64> = cmp.errors.iter().map(|e| e.pos_n.z).collect();
+    let plot = c.shade(
+        Plot::new("Position error against the truth", T_LABEL, "error [m]")
+            .line("circular error dS (horizontal)", &t, &ds, LineStyle::Solid)
+            .line("vertical dD (down)", &t, &dd, LineStyle::Dashed),
+    );
+    let svg = c.svg("position_error", &plot)?;
+    s.plot_with_files(&plot, &[&svg, "report/errors.csv"]);
+    Ok(())
+}
+
+/// One sensor quantity: name, file stem, unit and scale, and how to pick its
+/// estimate, standard deviation and truth.
+struct SensorQuantity {
+    name: &'static str,
+    stem: &'static str,
+    unit: &'static str,
+    scale: f64,
+    block: usize,
+}
+
+const SENSORS: [SensorQuantity; 4] = [
+    SensorQuantity {
+        name: "Gyro bias",
+        stem: "gyro_bias",
+        unit: "deg/h",
+        scale: DEG_PER_H,
+        block: 0,
+    },
+    SensorQuantity {
+        name: "Accelerometer bias",
+        stem: "accel_bias",
+        unit: "mGal",
+        scale: MGAL,
+        block: 1,
+    },
+    SensorQuantity {
+        name: "Gyro scale factor",
+        stem: "gyro_scale",
+        unit: "ppm",
+        scale: PPM,
+        block: 2,
+    },
+    SensorQuantity {
+        name: "Accelerometer scale factor",
+        stem: "accel_scale",
+        unit: "ppm",
+        scale: PPM,
+        block: 3,
+    },
+];
+
+fn sensor_block(e: &SensorEstimates, block: usize) -> nalgebra::Vector3<f64> {
+    match block {
+        0 => e.gyro_bias,
+        1 => e.accel_bias,
+        2 => e.gyro_scale,
+        _ => e.accel_scale,
+    }
+}
+
+fn sensor_section(r: &mut Report, c: &Ctx) -> Result<()> {
+    let data = c.data;
+    let samples = &data.recorder.samples;
+    let layout = data.facts.layout;
+    let s = r.section("sensors", "Estimated sensor errors");
+    s.paragraph(
+        "The filter's estimates with the ±3σ envelope of its covariance, sampled once a \
+         second (the seed's figures 6-7). Biases in deg/h and mGal, scale factors in ppm, \
+         as in imu_err.txt.",
+    );
+    if data.settings.sensor_truth.is_empty() {
+        s.paragraph(
+            "No sensor-error truth given: --sensor-truth FILE (imu_err.txt's layout) overlays \
+             it; `schuler simulate` does not write one yet.",
+        );
+    }
+    let t: Vec<f64> = samples.iter().map(|x| c.rel(x.t)).collect();
+    let tt: Vec<f64> = data
+        .settings
+        .sensor_truth
+        .iter()
+        .map(|x| c.rel(x.0))
+        .collect();
+    let estimated = [
+        true,
+        true,
+        layout.gyro_scale.is_some(),
+        layout.accel_scale.is_some(),
+    ];
+    let mut table = Table::new(["quantity", "unit", "x", "y", "z", "3σ x", "3σ y", "3σ z"]);
+    let mut header = String::from("t");
+    let mut columns: Vec<Column> = Vec::new();
+    for q in SENSORS.iter().filter(|q| estimated[q.block]) {
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            let est: Vec<f64> = samples
+                .iter()
+                .map(|x| sensor_block(&x.estimates, q.block)[i] / q.scale)
+                .collect();
+            let sd: Vec<f64> = samples
+                .iter()
+                .map(|x| 3.0 * x.sensor_std[q.block][i] / q.scale)
+                .collect();
+            let mut plot = with_envelope(
+                Plot::new(
+                    &format!("{} {axis}", q.name),
+                    T_LABEL,
+                    &format!("{}_{axis} [{}]", q.stem, q.unit),
+                ),
+                ("estimate", "estimate ± 3σ"),
+                &t,
+                &est,
+                &est,
+                &sd,
+            );
+            if !data.settings.sensor_truth.is_empty() {
+                let truth: Vec<f64> = data
+                    .settings
+                    .sensor_truth
+                    .iter()
+                    .map(|x| sensor_block(&x.1, q.block)[i] / q.scale)
+                    .collect();
+                plot = plot.line("truth", &tt, &truth, LineStyle::Dotted);
+            }
+            plot.height = 320;
+            let plot = c.shade(plot);
+            let svg = c.svg(&format!("{}_{axis}", q.stem), &plot)?;
+            s.plot_with_files(&plot, &[&svg, "report/sensor_errors.csv"]);
+            let _ = write!(
+                header,
+                ",{}_{axis}_{u},{}_{axis}_std_{u}",
+                q.stem,
+                q.stem,
+                u = q.unit.replace('/', "p")
+            );
+            let (block, scale) = (q.block, q.scale);
+            columns.push(Box::new(move |x: &ReportSample| {
+                sensor_block(&x.estimates, block)[i] / scale
+            }));
+            columns.push(Box::new(move |x: &ReportSample| {
+                x.sensor_std[block][i] / scale
+            }));
+        }
+        if let Some(last) = samples.last() {
+            let e = sensor_block(&last.estimates, q.block) / q.scale;
+            let sd = last.sensor_std[q.block] * 3.0 / q.scale;
+            table = table.row([
+                q.name.to_owned(),
+                q.unit.to_owned(),
+                f3(e.x),
+                f3(e.y),
+                f3(e.z),
+                f3(sd.x),
+                f3(sd.y),
+                f3(sd.z),
+            ]);
+        }
+    }
+    if layout.baro_bias.is_some() {
+        let est: Vec<f64> = samples.iter().map(|x| x.estimates.baro_bias).collect();
+        let sd: Vec<f64> = samples
+            .iter()
+            .map(|x| 3.0 * x.baro_std.unwrap_or(f64::NAN))
+            .collect();
+        let mut plot = with_envelope(
+            Plot::new("Barometer bias", T_LABEL, "baro bias [m]"),
+            ("estimate", "estimate ± 3σ"),
+            &t,
+            &est,
+            &est,
+            &sd,
+        );
+        plot.height = 320;
+        let plot = c.shade(plot);
+        let svg = c.svg("baro_bias", &plot)?;
+        s.plot_with_files(&plot, &[&svg, "report/sensor_errors.csv"]);
+        header.push_str(",baro_bias_m,baro_bias_std_m");
+        columns.push(Box::new(|x: &ReportSample| x.estimates.baro_bias));
+        columns.push(Box::new(|x: &ReportSample| x.baro_std.unwrap_or(f64::NAN)));
+        if let Some(last) = samples.last() {
+            table = table.row([
+                "Barometer bias".to_owned(),
+                "m".to_owned(),
+                f3(last.estimates.baro_bias),
+                String::new(),
+                String::new(),
+                f3(3.0 * last.baro_std.unwrap_or(f64::NAN)),
+                String::new(),
+                String::new(),
+            ]);
+        }
+    }
+    s.table(table.caption("Final estimates and their 3σ"));
+    c.csv(
+        "sensor_errors.csv",
+        &header,
+        samples.iter().map(|x| {
+            std::iter::once(Some(x.t))
+                .chain(columns.iter().map(|c| Some(c(x)).filter(|v| v.is_finite())))
+                .collect()
+        }),
+    )?;
+    Ok(())
+}
+
+/// Component names of a measurement of `dof` components in the filter's frame.
+fn components(kind: MechanizationKind, dof: usize) -> Vec<&'static str> {
+    match (dof, kind) {
+        (3, MechanizationKind::Ned) => vec!["north", "east", "down"],
+        (3, MechanizationKind::Wander) => vec!["x (wander)", "y (wander)", "down"],
+        (1, _) => vec![""],
+        _ => ["1", "2", "3"][..dof.min(3)].to_vec(),
+    }
+}
+
+fn innovation_section(r: &mut Report, c: &Ctx) -> Result<()> {
+    let data = c.data;
+    let rows = &data.recorder.innovations.rows;
+    let s = r.section("innovations", "Innovations");
+    s.paragraph(
+        "Innovation z = computed − measured of every measurement in the filter's frame, \
+         with ±3σ of its predicted covariance S = H P Hᵀ + R; refused measurements as dots.",
+    );
+    for k in nis_by_kind(rows) {
+        let of_kind: Vec<&InnovationRow> = rows.iter().filter(|r| r.kind == k.kind).collect();
+        let t: Vec<f64> = of_kind.iter().map(|r| c.rel(r.t)).collect();
+        for (i, name) in components(data.facts.mechanization, k.dof)
+            .into_iter()
+            .enumerate()
+        {
+            let pick = |keep: bool| -> Vec<f64> {
+                of_kind
+                    .iter()
+                    .map(|r| if r.accepted == keep { r.z[i] } else { f64::NAN })
+                    .collect()
+            };
+            let sigma: Vec<f64> = of_kind.iter().map(|r| 3.0 * r.sigma[i]).collect();
+            let title = if name.is_empty() {
+                format!("{} innovation", k.kind)
+            } else {
+                format!("{} innovation, {name}", k.kind)
+            };
+            let mut plot = with_envelope(
+                Plot::new(&title, T_LABEL, &format!("z [{}]", k.kind.unit())),
+                ("accepted", "±3σ(S)"),
+                &t,
+                &pick(true),
+                &vec![0.0; t.len()],
+                &sigma,
+            );
+            if k.refused > 0 {
+                plot = plot.line("refused", &t, &pick(false), LineStyle::Dotted);
+            }
+            plot.height = 320;
+            let plot = c.shade(plot);
+            let stem = format!("innovation_{}_{}", k.kind, i + 1);
+            let svg = c.svg(&stem, &plot)?;
+            s.plot_with_files(&plot, &[&svg, "innovations.csv"]);
+        }
+    }
+    Ok(())
+}
+
+fn test_row(name: String, t: &ChiSquareTest) -> [String; 7] {
+    [
+        name,
+        t.dof.to_string(),
+        t.count.to_string(),
+        format!("{:.3}", t.mean),
+        format!("{:.3}–{:.3}", t.mean_bounds.lo, t.mean_bounds.hi),
+        if t.mean_inside() { "yes" } else { "no" }.to_owned(),
+        format!("{:.1}", 100.0 * t.fraction_outside()),
+    ]
+}
+
+const TEST_HEADER: [&str; 7] = [
+    "statistic",
+    "dof",
+    "values",
+    "mean",
+    "95 % interval of the mean",
+    "mean inside",
+    "% outside the per-epoch 95 % interval",
+];
+
+fn bounds_plot(title: &str, y_label: &str, t: &[f64], v: &[f64], test: &ChiSquareTest) -> Plot {
+    let (a, b) = (
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(1.0),
+    );
+    let (t, v) = gapped(t, v);
+    let mut plot = Plot::new(title, T_LABEL, y_label)
+        .line("value", &t, &v, LineStyle::Solid)
+        .line(
+            &format!("{:.0} % bounds", 100.0 * PROBABILITY),
+            &[a, b, f64::NAN, a, b],
+            &[
+                test.epoch_bounds.hi,
+                test.epoch_bounds.hi,
+                f64::NAN,
+                test.epoch_bounds.lo,
+                test.epoch_bounds.lo,
+            ],
+            LineStyle::Dashed,
+        )
+        .line(
+            &format!("expected ({} dof)", test.dof),
+            &[a, b],
+            &[test.dof as f64, test.dof as f64],
+            LineStyle::Dotted,
+        );
+    plot.height = 320;
+    plot
+}
+
+fn nis_section(r: &mut Report, c: &Ctx, nis: &[KindConsistency]) -> Result<()> {
+    let data = c.data;
+    let rows = &data.recorder.innovations.rows;
+    let s = r.section("nis", "Consistency: normalized innovations (NIS)");
+    s.paragraph(&format!(
+        "NIS = zᵀ S⁻¹ z of each accepted measurement; for a consistent filter chi-square with \
+         the measurement's dimension. The per-update interval holds {:.0} % of the values; \
+         the mean of N independent values lies in chi2(N dof)/N's interval (innovations of \
+         an optimal filter are white).",
+        100.0 * PROBABILITY
+    ));
+    let mut table = Table::new(TEST_HEADER);
+    for k in nis {
+        let Some(test) = &k.test else { continue };
+        table = table.row(test_row(format!("NIS {}", k.kind), test));
+        let (t, v): (Vec<f64>, Vec<f64>) = rows
+            .iter()
+            .filter(|r| r.kind == k.kind && r.accepted)
+            .map(|r| (c.rel(r.t), r.nis))
+            .unzip();
+        let plot = c.shade(bounds_plot(
+            &format!("NIS, {}", k.kind),
+            "NIS [-]",
+            &t,
+            &v,
+            test,
+        ));
+        let svg = c.svg(&format!("nis_{}", k.kind), &plot)?;
+        s.plot_with_files(&plot, &[&svg, "innovations.csv"]);
+    }
+    s.table(table.caption("NIS against chi-square"));
+    Ok(())
+}
+
+fn nees_section(r: &mut Report, c: &Ctx, nees: &[Option<ChiSquareTest>; 3]) -> Result<()> {
+    let data = c.data;
+    let samples = &data.recorder.samples;
+    let s = r.section("nees", "Consistency: normalized estimation errors (NEES)");
+    s.paragraph(
+        "NEES = eᵀ P⁻¹ e of the position, velocity and attitude errors against the truth, \
+         with the filter's 3x3 covariance blocks in NED, once a second; chi-square with 3 \
+         dof for a consistent filter. Successive values are correlated, so the interval of \
+         the mean (which assumes independence) is narrower than one run's spread.",
+    );
+    let nees_of = |s: &ReportSample, k: usize| s.nees.and_then(|n| n[k]);
+    c.csv(
+        "nees.csv",
+        "t,nees_position,nees_velocity,nees_attitude",
+        samples
+            .iter()
+            .filter(|x| x.nees.is_some())
+            .map(|x| vec![Some(x.t), nees_of(x, 0), nees_of(x, 1), nees_of(x, 2)]),
+    )?;
+    let mut table = Table::new(TEST_HEADER);
+    for (k, (name, test)) in NEES_BLOCKS.iter().zip(nees).enumerate() {
+        let Some(test) = test else { continue };
+        table = table.row(test_row(format!("NEES {name}"), test));
+        let (t, v): (Vec<f64>, Vec<f64>) = samples
+            .iter()
+            .filter(|x| x.nees.is_some())
+            .map(|x| (c.rel(x.t), nees_of(x, k).unwrap_or(f64::NAN)))
+            .unzip();
+        let plot = c.shade(bounds_plot(
+            &format!("NEES, {name}"),
+            "NEES [-]",
+            &t,
+            &v,
+            test,
+        ));
+        let svg = c.svg(&format!("nees_{name}"), &plot)?;
+        s.plot_with_files(&plot, &[&svg, "report/nees.csv"]);
+    }
+    s.table(table.caption("NEES against chi-square"));
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use schuler::earth::Geodetic;
+
+    fn row(t: f64, kind: Kind, dof: usize, nis: f64, accepted: bool) -> InnovationRow {
+        InnovationRow {
+            t,
+            kind,
+            accepted,
+            dof,
+            nis,
+            z: [0.0; 3],
+            sigma: [1.0; 3],
+        }
+    }
+
+    #[test]
+    fn nis_is_tested_per_kind_over_accepted_measurements() {
+        let rows = [
+            row(1.0, Kind::GnssPosition, 3, 2.0, true),
+            row(1.0, Kind::GnssVelocity, 3, 4.0, true),
+            row(1.1, Kind::BaroHeight, 1, 6.0, true),
+            row(2.0, Kind::GnssPosition, 3, 2500.0, false),
+            row(3.0, Kind::GnssPosition, 3, 10.0, true),
+        ];
+        let k = nis_by_kind(&rows);
+        assert_eq!(
+            k.iter()
+                .map(|k| (k.kind, k.dof, k.accepted, k.refused))
+                .collect::<Vec<_>>(),
+            [
+                (Kind::GnssPosition, 3, 2, 1),
+                (Kind::GnssVelocity, 3, 1, 0),
+                (Kind::BaroHeight, 1, 1, 0)
+            ]
+        );
+        let pos = k[0].test.expect("accepted");
+        // The refused 2500 is left out: mean of 2 and 10. chi2(3) 97.5 % is 9.348
+        // (mpmath), so 10 is above the per-update interval.
+        assert_eq!(pos.mean, 6.0);
+        assert_eq!(pos.fraction_above, 0.5);
+        assert!((pos.epoch_bounds.hi - 9.348_403_60).abs() < 1e-6);
+        // Baro: chi2(1) 97.5 % is 5.0239, 6 is above.
+        assert_eq!(k[2].test.expect("baro").fraction_above, 1.0);
+        let j = consistency_json(&k, None);
+        assert_eq!(j["nis"][0]["kind"], "gnss_position");
+        assert_eq!(j["nis"][0]["refused"], 1);
+        assert_eq!(j["nis"][0]["test"]["mean"], 6.0);
+        assert!(j["nees"].is_null());
+        let text = consistency_text(&k, None);
+        assert!(
+            text.contains("NIS  gnss_position  3 dof: mean 6.000"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn gaps_are_intervals_longer_than_twice_the_spacing() {
+        let fix = |t: f64| GnssFix {
+            t,
+            pos: Geodetic::from_degrees(45.0, 7.0, 0.0),
+            pos_std: nalgebra::Vector3::repeat(1.0),
+            vel: None,
+        };
+        let fixes: Vec<GnssFix> = [0.0, 1.0, 2.0, 3.0, 63.0, 64.0, 66.5, 67.0]
+            .into_iter()
+            .map(fix)
+            .collect();
+        assert_eq!(gnss_gaps(&fixes), [(3.0, 63.0), (64.0, 66.5)]);
+        assert!(gnss_gaps(&fixes[..2]).is_empty());
+    }
+}

@@ -1,0 +1,282 @@
+//! Navigation results and truths as files: KF-GINS navigation text or schuler's
+//! `nav.csv`, read whole into [`NavRecord`]s.
+//!
+//! A file may be KF-GINS navigation text (11 columns: `week sow lat lon h vn ve vd
+//! roll pitch yaw`, degrees, metres, m/s; as schuler's `nav.txt`, KF-GINS's
+//! `KF_GINS_Navresult.nav` and the data sets' `truth.nav`) or schuler's `nav.csv` (a
+//! header naming at least `t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,
+//! pitch_deg,yaw_deg`, in any order, other columns ignored). The format is told by the
+//! first data line: a header starts with a letter. Blank lines and `#`/`%` comments are
+//! skipped. The time is the second of week; in a KF-GINS file a later week continues
+//! it (`sow + 604800 (week - first week)`), so a rollover inside a file is no step, but
+//! the weeks of two files are not compared (schuler writes week 0 where it knows none).
+//! A file is read whole (80 bytes per epoch).
+
+use super::error::{InputError, InputErrorKind, quote_field};
+use nalgebra::Vector3;
+use schuler::analysis::errors::NavRecord;
+use schuler::earth::Geodetic;
+use schuler::rotation::Euler;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+/// Seconds in a GPS week.
+const WEEK_S: f64 = 604_800.0;
+
+/// The layouts [`read_nav`] tells apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NavFormat {
+    /// KF-GINS navigation text, 11 columns, no header.
+    KfGins,
+    /// CSV with a header naming the columns (schuler's `nav.csv`).
+    Csv,
+}
+
+impl NavFormat {
+    /// The name used in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            NavFormat::KfGins => "kf-gins",
+            NavFormat::Csv => "csv",
+        }
+    }
+}
+
+/// KF-GINS column names, in file order.
+const KF_GINS_FIELDS: [&str; 11] = [
+    "week", "sow", "lat", "lon", "h", "vn", "ve", "vd", "roll", "pitch", "yaw",
+];
+
+/// CSV columns read, in [`NavRecord`] order after time.
+const CSV_FIELDS: [&str; 10] = [
+    "t_sow",
+    "lat_deg",
+    "lon_deg",
+    "h_m",
+    "vn_mps",
+    "ve_mps",
+    "vd_mps",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+];
+
+/// Reads a navigation file whole (either layout, told by its first data line),
+/// checking column counts, numbers, finiteness, latitude range, whole weeks and
+/// strictly increasing time; errors name the file, line and field.
+pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> {
+    let io_err = |e: std::io::Error| {
+        InputError::new(
+            InputErrorKind::Io,
+            path,
+            0,
+            None,
+            format!("cannot read: {e}"),
+        )
+    };
+    let file = std::fs::File::open(path).map_err(io_err)?;
+    let mut reader = BufReader::with_capacity(1 << 20, file);
+    let mut buf: Vec<u8> = Vec::new();
+    let mut n: u64 = 0;
+    let mut format = None;
+    // For CSV: the column count and the index of each of CSV_FIELDS.
+    let mut csv_columns = (0usize, [0usize; 10]);
+    let mut first_week = None;
+    let mut rows: Vec<NavRecord> = Vec::new();
+    loop {
+        buf.clear();
+        if reader.read_until(b'\n', &mut buf).map_err(io_err)? == 0 {
+            break;
+        }
+        n += 1;
+        let l = std::str::from_utf8(&buf)
+            .map_err(|_| {
+                InputError::new(InputErrorKind::NotANumber, path, n, None, "not UTF-8 text")
+            })?
+            .trim();
+        if l.is_empty() || l.starts_with('#') || l.starts_with('%') {
+            continue;
+        }
+        let fmt = match format {
+            Some(f) => f,
+            None => {
+                let f = if l.starts_with(|c: char| c.is_ascii_alphabetic() || c == '"') {
+                    csv_columns = csv_header(path, n, l)?;
+                    NavFormat::Csv
+                } else {
+                    NavFormat::KfGins
+                };
+                format = Some(f);
+                if f == NavFormat::Csv {
+                    continue;
+                }
+                f
+            }
+        };
+        let at = |field: &str, kind, msg: String| InputError::new(kind, path, n, Some(field), msg);
+        let number = |field: &str, text: &str| -> Result<f64, InputError> {
+            let x: f64 = text.parse().map_err(|_| {
+                at(
+                    field,
+                    InputErrorKind::NotANumber,
+                    format!("not a number: {}", quote_field(text.as_bytes())),
+                )
+            })?;
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(at(
+                    field,
+                    InputErrorKind::NotFinite,
+                    format!("not finite: {}", quote_field(text.as_bytes())),
+                ))
+            }
+        };
+        // v: time, lat, lon [deg], h, vn, ve, vd, roll, pitch, yaw [deg].
+        let mut v = [0.0; 10];
+        let names: [&str; 10];
+        match fmt {
+            NavFormat::KfGins => {
+                let fields: Vec<&str> = l
+                    .split(|c: char| c.is_whitespace() || c == ',')
+                    .filter(|f| !f.is_empty())
+                    .collect();
+                if fields.len() != KF_GINS_FIELDS.len() {
+                    return Err(InputError::new(
+                        InputErrorKind::ColumnCount,
+                        path,
+                        n,
+                        None,
+                        format!(
+                            "{} columns, expected 11 (week sow lat lon h vn ve vd roll pitch yaw)",
+                            fields.len()
+                        ),
+                    ));
+                }
+                let mut x = [0.0; 11];
+                for (k, f) in fields.iter().enumerate() {
+                    x[k] = number(KF_GINS_FIELDS[k], f)?;
+                }
+                let week = x[0];
+                if week < 0.0 || week.fract() != 0.0 {
+                    return Err(at(
+                        "week",
+                        InputErrorKind::NotANumber,
+                        format!("a GPS week is a whole number >= 0, got {}", fields[0]),
+                    ));
+                }
+                let week0 = *first_week.get_or_insert(week);
+                v[0] = x[1] + (week - week0) * WEEK_S;
+                v[1..].copy_from_slice(&x[2..]);
+                names = [
+                    "sow", "lat", "lon", "h", "vn", "ve", "vd", "roll", "pitch", "yaw",
+                ];
+            }
+            NavFormat::Csv => {
+                let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+                if fields.len() != csv_columns.0 {
+                    return Err(InputError::new(
+                        InputErrorKind::ColumnCount,
+                        path,
+                        n,
+                        None,
+                        format!(
+                            "{} columns, the header names {}",
+                            fields.len(),
+                            csv_columns.0
+                        ),
+                    ));
+                }
+                for (k, &i) in csv_columns.1.iter().enumerate() {
+                    v[k] = number(CSV_FIELDS[k], fields[i])?;
+                }
+                names = CSV_FIELDS;
+            }
+        }
+        if !(-90.0..=90.0).contains(&v[1]) {
+            return Err(at(
+                names[1],
+                InputErrorKind::NotANumber,
+                format!("latitude {} is outside [-90, 90]", v[1]),
+            ));
+        }
+        if let Some(prev) = rows.last()
+            && v[0] <= prev.t_sow
+        {
+            return Err(at(
+                names[0],
+                InputErrorKind::TimeNotIncreasing,
+                format!("time {} does not increase (previous {})", v[0], prev.t_sow),
+            ));
+        }
+        rows.push(NavRecord {
+            t_sow: v[0],
+            pos: Geodetic::from_degrees(v[1], v[2], v[3]),
+            v_n: Vector3::new(v[4], v[5], v[6]),
+            att: Euler::from_degrees(v[7], v[8], v[9]),
+        });
+    }
+    match format {
+        Some(f) if !rows.is_empty() => Ok((f, rows)),
+        _ => Err(InputError::new(
+            InputErrorKind::NoData,
+            path,
+            0,
+            None,
+            "no data line",
+        )),
+    }
+}
+
+/// The column count of a CSV header and where each of [`CSV_FIELDS`] is.
+fn csv_header(path: &Path, n: u64, l: &str) -> Result<(usize, [usize; 10]), InputError> {
+    let names: Vec<&str> = l.split(',').map(|s| s.trim().trim_matches('"')).collect();
+    let mut index = [0usize; 10];
+    for (k, want) in CSV_FIELDS.iter().enumerate() {
+        index[k] = names.iter().position(|h| h == want).ok_or_else(|| {
+            InputError::new(
+                InputErrorKind::Header,
+                path,
+                n,
+                Some(want),
+                format!(
+                    "the header lacks column {want} (needs {})",
+                    CSV_FIELDS.join(",")
+                ),
+            )
+        })?;
+    }
+    Ok((names.len(), index))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(text: &[u8]) -> tempfile::NamedTempFile {
+        let f = tempfile::NamedTempFile::new().expect("temp");
+        std::fs::write(f.path(), text).expect("write");
+        f
+    }
+
+    #[test]
+    fn a_week_rollover_inside_a_file_continues_the_time() {
+        let f = file(b"2299 604799.5 45 7 100 0 0 0 0 0 10\n2300 0.5 45 7 100 0 0 0 0 0 10\n");
+        let (format, rows) = read_nav(f.path()).expect("reads");
+        assert_eq!(format, NavFormat::KfGins);
+        assert_eq!(rows[1].t_sow, 604_800.5);
+        let f = file(b"0 1.0 45 7 100 0 0 0 0 0 10\n0.5 2.0 45 7 100 0 0 0 0 0 10\n");
+        let e = read_nav(f.path()).expect_err("half a week").to_string();
+        assert!(
+            e.contains(":2: field week: a GPS week is a whole number"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn invalid_utf8_names_its_line() {
+        let f = file(b"0 1.0 45 7 100 0 0 0 0 0 10\n0 2.0 45 7 1\xff0 0 0 0 0 0 10\n");
+        let e = read_nav(f.path()).expect_err("not text").to_string();
+        assert!(e.contains(":2: not UTF-8 text"), "{e}");
+    }
+}
