@@ -235,13 +235,7 @@ impl<'a> RunRecorder<'a> {
         } else {
             match self.cursor.at(self.truth, state.t) {
                 TruthAt::Exact(truth) | TruthAt::Interpolated(truth, _) => {
-                    let nav = NavRecord {
-                        t_sow: state.t,
-                        pos: state.pos,
-                        v_n: state.v_n,
-                        att: state.euler(),
-                    };
-                    let e = errors_at(&nav, &truth);
+                    let e = errors_at(&NavRecord::from(&state), &truth);
                     let psi = attitude_error(&state.q_bn, &truth.att.to_quaternion());
                     let [pp, pv, pa] = integ.nav_covariance();
                     Some([

@@ -41,6 +41,18 @@ pub struct NavRecord {
     pub att: Euler,
 }
 
+impl From<&crate::nav::NavState> for NavRecord {
+    /// A mechanization's or filter's state as a record (attitude as ZYX Euler angles).
+    fn from(s: &crate::nav::NavState) -> Self {
+        Self {
+            t_sow: s.t,
+            pos: s.pos,
+            v_n: s.v_n,
+            att: s.euler(),
+        }
+    }
+}
+
 /// Errors of one NAV epoch against the truth at its time (NAV minus truth).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EpochErrors {

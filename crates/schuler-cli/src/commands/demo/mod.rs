@@ -48,7 +48,7 @@ pub struct ModeRun {
     /// The track.
     pub track: modes::Track,
     /// Its errors against the truth.
-    pub errors: Vec<errors::ErrorEpoch>,
+    pub errors: Vec<schuler::analysis::errors::EpochErrors>,
 }
 
 /// Both alignments: coarse and fine from the start, and coarse alone over the last

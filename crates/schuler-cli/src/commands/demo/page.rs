@@ -3,12 +3,13 @@
 //! to the CSVs (one formatter for both), so the report and the data never disagree.
 
 use super::capture::Recording;
-use super::errors::{self, ErrorEpoch};
+use super::errors::{self, height};
 use super::modes::{BARO_LOOP_TAU, Track};
 use super::{Alignments, ModeRun, Sortie};
 use crate::plot::{LineStyle, Plot};
 use crate::report::{Report, Table};
 use anyhow::{Context, Result};
+use schuler::analysis::errors::EpochErrors;
 use schuler::channel::vertical::Gains;
 use schuler::units::{DEG_PER_H, UG};
 use std::fmt::Write as _;
@@ -53,8 +54,8 @@ fn svg(dir: &Path, name: &str, plot: &Plot) -> Result<()> {
 }
 
 /// Time axis of a series of errors [s].
-fn times(e: &[ErrorEpoch]) -> Vec<f64> {
-    e.iter().map(|x| x.t).collect()
+fn times(e: &[EpochErrors]) -> Vec<f64> {
+    e.iter().map(|x| x.t_sow).collect()
 }
 
 /// `errors_<key>.csv` and `nav_<key>.csv` of one mode.
@@ -66,14 +67,14 @@ fn write_mode(dir: &Path, run: &ModeRun) -> Result<()> {
         run.errors.iter().map(|e| {
             format!(
                 "{:.0},{},{},{},{},{},{},{}",
-                e.t,
-                m(e.north),
-                m(e.east),
-                m(e.circular),
-                m(e.height),
-                arcmin(e.attitude[0]),
-                arcmin(e.attitude[1]),
-                arcmin(e.attitude[2])
+                e.t_sow,
+                m(e.pos_n.x),
+                m(e.pos_n.y),
+                m(e.horizontal()),
+                m(height(e)),
+                arcmin(e.att.roll),
+                arcmin(e.att.pitch),
+                arcmin(e.att.yaw)
             )
         }),
     )?;
@@ -110,14 +111,14 @@ fn write_mode(dir: &Path, run: &ModeRun) -> Result<()> {
 fn summary_row(run: &ModeRun, s: &Sortie, end: f64) -> Vec<String> {
     debug_assert!(!run.label.contains(','), "labels are CSV cells");
     let e = &run.errors;
-    let at = |t: f64| errors::at(e, t).map_or("-".to_string(), |x| m(x.circular));
+    let at = |t: f64| errors::at(e, t).map_or("-".to_string(), |x| m(x.horizontal()));
     let outage_end = s.outages.last().map_or(end, |o| o.1);
     let dh = e
         .iter()
-        .filter(|x| x.t >= s.takeoff)
-        .map(|x| x.height.abs())
+        .filter(|x| x.t_sow >= s.takeoff)
+        .map(|x| height(x).abs())
         .fold(0.0, f64::max);
-    let yaw = e.last().map_or("-".to_string(), |x| arcmin(x.attitude[2]));
+    let yaw = e.last().map_or("-".to_string(), |x| arcmin(x.att.yaw));
     vec![
         run.label.to_string(),
         at(s.takeoff),
@@ -147,7 +148,7 @@ fn plot_circular(title: &str, runs: &[&ModeRun], s: &Sortie) -> Plot {
     let mut p = Plot::new(title, "t [s]", "dS [m]");
     let styles = [LineStyle::Solid, LineStyle::Dashed, LineStyle::Dotted];
     for (r, style) in runs.iter().zip(styles.iter().cycle()) {
-        let y: Vec<f64> = r.errors.iter().map(|e| e.circular).collect();
+        let y: Vec<f64> = r.errors.iter().map(EpochErrors::horizontal).collect();
         p = p.line(r.label, &times(&r.errors), &y, *style);
     }
     p.shade("GNSS outage", s.outages.iter().copied())
@@ -504,7 +505,7 @@ pub fn write(
     let no_baro = find(runs, "inertial_no_baro")?;
     let mut p = Plot::new("Vertical channel: height error", "t [s]", "dh [m]");
     for r in [no_baro, inertial, forward] {
-        let y: Vec<f64> = r.errors.iter().map(|e| e.height).collect();
+        let y: Vec<f64> = r.errors.iter().map(height).collect();
         p = p.line(r.label, &times(&r.errors), &y, LineStyle::Solid);
     }
     svg(dir, "vertical.svg", &p)?;
