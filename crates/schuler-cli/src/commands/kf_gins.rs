@@ -197,7 +197,7 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
             accel_bias: Vector3::from(y.initaccbias) * MGAL,
             gyro_scale: Vector3::from(y.initgyrscale) * PPM,
             accel_scale: Vector3::from(y.initaccscale) * PPM,
-            baro_bias: 0.0,
+            ..SensorEstimates::default()
         },
     };
     Ok(KfGinsRun { settings, aiding })
