@@ -22,7 +22,7 @@ pub mod rest;
 pub use coarse::{CoarseAlignment, HeadingSource};
 pub use fine::{Convergence, FineAlignment, FineConfig};
 pub use prefilter::{MotionReport, Spike};
-pub use rest::{RestDetector, RestVerdict};
+pub use rest::{Gravity, RestDetector, RestVerdict};
 
 use crate::earth::{EarthModel, Geodetic};
 use crate::filter::kalman::duplicate_states;

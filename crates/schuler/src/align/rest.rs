@@ -9,18 +9,20 @@
 //!    beyond `3 N_g/√T_block`) nor vibration (samples scattering beyond `3 N_a/√dt`)
 //!    ([`motion_of_blocks`]), nor do the block-mean specific forces scatter beyond
 //!    `3 N_a/√T_block` (a changing acceleration);
-//! 2. the mean specific force has the magnitude of gravity:
+//! 2. the mean specific force is gravity's: with only its magnitude known,
 //!    `| |f̄| − g | ≤ 3 (N_a/√T + σ_ba)`, with the velocity random walk `N_a` and the
 //!    accelerometer bias's standard deviation `σ_ba` (the samples are raw or only
-//!    partly compensated);
+//!    partly compensated); with the navigation's attitude, the whole vector,
+//!    `|f̄ − f_rest| ≤ 3 (N_a/√T + σ_ba) + g σ_tilt`, `f_rest = −C_bn g^n`;
 //! 3. the mean rate is the Earth's: `|ω̄| ≤ Ω + 3 (N_g/√T + σ_bg)`.
 //!
 //! Like every IMU-only detector (Skog et al. 2010, IEEE TBME 57(11), "zero-velocity
 //! detection — an algorithm evaluation"), it cannot tell rest from motion at constant
 //! velocity without vibration: a simulated vehicle on a straight road at constant
-//! speed passes all three tests. Nor a steady horizontal acceleration `a` from a tilt:
-//! it changes `|f|` by only `a²/2g`. Real vehicles vibrate when they move; otherwise
-//! the caller must rule these out by other means (the navigation's own speed, the
+//! speed passes all three tests. Nor, from the magnitude alone, a steady horizontal
+//! acceleration `a` from a tilt: it changes `|f|` by only `a²/2g` (the attitude's
+//! vector test sees `a` itself). Real vehicles vibrate when they move; otherwise the
+//! caller must rule these out by other means (the navigation's own speed, the
 //! innovation gate).
 
 use super::prefilter::{BlockSums, motion_of_blocks};
@@ -30,6 +32,17 @@ use nalgebra::Vector3;
 
 /// Multiple of the noise a rest window may show (as [`super::prefilter::MOTION_FACTOR`]).
 const FACTOR: f64 = super::prefilter::MOTION_FACTOR;
+
+/// What the caller knows of the specific force a body at rest feels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Gravity {
+    /// Gravity's magnitude [m/s^2] (no attitude): the test is on `|f̄|`.
+    Magnitude(f64),
+    /// The specific force at rest in body axes, `−C_bn g^n` [m/s^2], from the
+    /// navigation's attitude, and the attitude's tilt uncertainty [rad]: the test is
+    /// on the vector.
+    Body(Vector3<f64>, f64),
+}
 
 /// What the detector says at the end of a block.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,9 +87,9 @@ impl RestDetector {
     }
 
     /// Add a sample; at the end of a block (within half a sample of `block` seconds),
-    /// the verdict on the window ending there, with local gravity `gravity` [m/s^2]
-    /// and Earth rate `earth_rate` [rad/s]. Allocation-free.
-    pub fn add(&mut self, s: &ImuSample, gravity: f64, earth_rate: f64) -> Option<RestVerdict> {
+    /// the verdict on the window ending there, with `gravity` as known now and the
+    /// Earth rate `earth_rate` [rad/s]. Allocation-free.
+    pub fn add(&mut self, s: &ImuSample, gravity: Gravity, earth_rate: f64) -> Option<RestVerdict> {
         if s.dt <= 0.0 {
             return None;
         }
@@ -96,7 +109,7 @@ impl RestDetector {
         })
     }
 
-    fn at_rest(&self, gravity: f64, earth_rate: f64) -> bool {
+    fn at_rest(&self, gravity: Gravity, earth_rate: f64) -> bool {
         let motion = motion_of_blocks(&self.blocks, &self.arw, &self.vrw);
         if motion.angular_motion || motion.vibration {
             return false;
@@ -113,8 +126,12 @@ impl RestDetector {
                 <= FACTOR * self.vrw[i].max(f64::MIN_POSITIVE) / t_block.sqrt()
         });
         let sqrt_t = t.sqrt();
-        let force_ok = ((dvel / t).norm() - gravity).abs()
-            <= FACTOR * (self.vrw.max() / sqrt_t + self.accel_bias);
+        let allowance = FACTOR * (self.vrw.max() / sqrt_t + self.accel_bias);
+        let f = dvel / t;
+        let force_ok = match gravity {
+            Gravity::Magnitude(g) => (f.norm() - g).abs() <= allowance,
+            Gravity::Body(f_rest, tilt) => (f - f_rest).norm() <= allowance + f_rest.norm() * tilt,
+        };
         let rate_ok =
             (dtheta / t).norm() <= earth_rate + FACTOR * (self.arw.max() / sqrt_t + self.gyro_bias);
         steady && force_ok && rate_ok
@@ -160,7 +177,9 @@ mod tests {
 
     fn verdicts(s: &[ImuSample]) -> Vec<RestVerdict> {
         let mut d = RestDetector::new(&noise(), 0.1, 10);
-        s.iter().filter_map(|s| d.add(s, 9.81, 7.292e-5)).collect()
+        s.iter()
+            .filter_map(|s| d.add(s, Gravity::Magnitude(9.81), 7.292e-5))
+            .collect()
     }
 
     #[test]
@@ -199,13 +218,29 @@ mod tests {
         );
         assert!(verdicts(&braking).iter().all(|v| !v.rest));
         // A steady horizontal acceleration is a tilt to the accelerometers (the
-        // module doc): 0.5 m/s² changes |f| by 0.013 m/s² only.
+        // module doc): 0.5 m/s² changes |f| by 0.013 m/s² only...
         let steady = samples(
             1000,
             |_| Vector3::zeros(),
             |_| Vector3::new(-0.5, 0.0, -9.81),
         );
         assert!(verdicts(&steady)[9..].iter().all(|v| v.rest));
+        // ... but not with the attitude (level, known to 1 mrad): 0.5 m/s² against an
+        // allowance of 0.26 + 0.01 m/s².
+        let mut d = RestDetector::new(&noise(), 0.1, 10);
+        let level = Gravity::Body(Vector3::new(0.0, 0.0, -9.81), 1e-3);
+        assert!(
+            steady
+                .iter()
+                .filter_map(|s| d.add(s, level, 7.292e-5))
+                .all(|v| !v.rest)
+        );
+        let mut d = RestDetector::new(&noise(), 0.1, 10);
+        let v: Vec<RestVerdict> = still
+            .iter()
+            .filter_map(|s| d.add(s, level, 7.292e-5))
+            .collect();
+        assert!(v[9..].iter().all(|v| v.rest));
         // Turning at 1 deg/s: never rest.
         let turning = samples(
             1000,
