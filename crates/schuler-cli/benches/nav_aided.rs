@@ -82,6 +82,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         initial_errors: Default::default(),
         outage_test: None,
         baro: None,
+        vehicle: Default::default(),
     };
     (settings, aiding)
 }

@@ -192,6 +192,7 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         names: OutputNames::KF_GINS,
         outage_test: None,
         baro: None,
+        vehicle: Default::default(),
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
             accel_bias: Vector3::from(y.initaccbias) * MGAL,

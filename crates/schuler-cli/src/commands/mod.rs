@@ -10,4 +10,5 @@ pub mod kf_gins;
 pub mod nav;
 pub mod platform;
 pub mod simulate;
+pub mod vehicle;
 pub mod vertical;

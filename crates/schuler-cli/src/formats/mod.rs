@@ -9,6 +9,7 @@ pub mod error;
 pub mod gnss;
 pub mod imu_log;
 mod lines;
+pub mod vehicle;
 
 pub use error::InputError;
 pub use imu_log::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};

@@ -66,6 +66,7 @@ pub struct RestDetector {
     vrw: Vector3<f64>,
     gyro_bias: f64,
     accel_bias: f64,
+    last_t: f64,
 }
 
 impl RestDetector {
@@ -83,30 +84,41 @@ impl RestDetector {
             vrw: noise.vrw,
             gyro_bias: noise.gyro_bias.norm(),
             accel_bias: noise.accel_bias.norm(),
+            last_t: f64::NAN,
         }
     }
 
-    /// Add a sample; at the end of a block (within half a sample of `block` seconds),
-    /// the verdict on the window ending there, with `gravity` as known now and the
-    /// Earth rate `earth_rate` [rad/s]. Allocation-free.
-    pub fn add(&mut self, s: &ImuSample, gravity: Gravity, earth_rate: f64) -> Option<RestVerdict> {
+    /// Add a sample; true when it ends a block (within half a sample of `block`
+    /// seconds), whose verdict [`RestDetector::verdict`] then gives. Allocation-free.
+    pub fn push(&mut self, s: &ImuSample) -> bool {
         if s.dt <= 0.0 {
-            return None;
+            return false;
         }
         self.current.add(s);
         if self.current.t < self.block - 0.5 * s.dt {
-            return None;
+            return false;
         }
-        let block = std::mem::take(&mut self.current);
         if self.blocks.len() == self.window {
             self.blocks.remove(0);
         }
-        self.blocks.push(block);
-        Some(RestVerdict {
-            t: s.t,
+        self.blocks.push(std::mem::take(&mut self.current));
+        self.last_t = s.t;
+        true
+    }
+
+    /// The verdict on the window ending with the last block, with `gravity` as known
+    /// now and the Earth rate `earth_rate` [rad/s]. Allocation-free.
+    pub fn verdict(&self, gravity: Gravity, earth_rate: f64) -> RestVerdict {
+        RestVerdict {
+            t: self.last_t,
             rest: self.blocks.len() == self.window && self.at_rest(gravity, earth_rate),
-            block,
-        })
+            block: self.blocks.last().copied().unwrap_or_default(),
+        }
+    }
+
+    /// [`RestDetector::push`], and at the end of a block its verdict.
+    pub fn add(&mut self, s: &ImuSample, gravity: Gravity, earth_rate: f64) -> Option<RestVerdict> {
+        self.push(s).then(|| self.verdict(gravity, earth_rate))
     }
 
     fn at_rest(&self, gravity: Gravity, earth_rate: f64) -> bool {
