@@ -664,6 +664,7 @@ impl AidingOptions {
         if self.gnss.is_none() && self.gnss_vel.is_some() {
             bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
         }
+        super::vehicle::check_dependencies(self)?;
         if !self.any() {
             return Ok(None);
         }

@@ -91,15 +91,8 @@ impl Default for VehicleAiding {
     }
 }
 
-/// Check the vehicle options and load their files.
-pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<VehicleAiding> {
-    let positive = |flag: &str, v: &Option<String>, dim: Dimension, default: f64| {
-        let x = quantity(flag, v, dim)?.unwrap_or(default);
-        if x <= 0.0 {
-            bail!("--{flag} must be positive, got {x}");
-        }
-        Ok(x)
-    };
+/// Refuse options given without the aid they tune (e.g. `--nhc-std` without `--nhc`).
+pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
     for (given, flag, needs, main) in [
         (
             o.zupt_std.is_some(),
@@ -160,6 +153,19 @@ pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<VehicleAiding> {
     if o.zupt.is_some() && o.zupt_detect {
         bail!("--zupt FILE and --zupt-detect exclude each other");
     }
+    Ok(())
+}
+
+/// Check the vehicle options and load their files.
+pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<VehicleAiding> {
+    check_dependencies(o)?;
+    let positive = |flag: &str, v: &Option<String>, dim: Dimension, default: f64| {
+        let x = quantity(flag, v, dim)?.unwrap_or(default);
+        if x <= 0.0 {
+            bail!("--{flag} must be positive, got {x}");
+        }
+        Ok(x)
+    };
     let interval = positive("zupt-interval", &o.zupt_interval, Dimension::Time, 0.1)?;
     let source = match (&o.zupt, o.zupt_detect) {
         (Some(path), _) => Some(RestSource::Intervals(
