@@ -23,15 +23,7 @@ fn vertical_max_in(nav: &Path, truth: &Path, from: f64, to: f64) -> f64 {
 fn a_barometer_holds_the_height_through_the_outage() {
     let dir = tempfile::tempdir().expect("tempdir");
     let sim = dir.path().join("sim");
-    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drive.toml");
-    assert_cmd::Command::cargo_bin("schuler")
-        .expect("binary")
-        .args(["simulate", "--config"])
-        .arg(&example)
-        .arg("--out")
-        .arg(&sim)
-        .assert()
-        .success();
+    common::simulate_example_drive(&sim);
     let run = |name: &str, baro: bool| {
         let out = dir.path().join(name);
         let mut c = assert_cmd::Command::cargo_bin("schuler").expect("binary");

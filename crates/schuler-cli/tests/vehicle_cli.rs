@@ -24,15 +24,7 @@ fn drive() -> &'static Path {
     &DIR.get_or_init(|| {
         let dir = tempfile::tempdir().expect("tempdir");
         let sim = dir.path().join("drive");
-        let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drive.toml");
-        assert_cmd::Command::cargo_bin("schuler")
-            .expect("binary")
-            .args(["simulate", "--config"])
-            .arg(&example)
-            .arg("--out")
-            .arg(&sim)
-            .assert()
-            .success();
+        common::simulate_example_drive(&sim);
         let truth: Vec<NavState> = common::read_rows(&sim.join("truth.nav"))
             .iter()
             .map(|r| {

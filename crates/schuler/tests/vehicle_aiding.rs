@@ -11,14 +11,14 @@ use schuler::align::{Gravity, RestDetector};
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::{GnssFix, IntegrationConfig, Integrator};
 use schuler::filter::measurement::Kind;
-use schuler::filter::{Baseline, Gate, ImuNoise, VehicleMount};
+use schuler::filter::{Baseline, ImuNoise, VehicleMount};
 use schuler::imu::ImuSample;
 use schuler::nav::{LocalLevel, NavState};
 use schuler::rotation::{Euler, wrap_pi};
-use schuler::sim::analytic::Kinematics;
+use schuler::sim::analytic;
 use schuler::sim::imu_model::ImuSimulator;
-use schuler::sim::receivers::{BaroReading, GnssModel, GnssSimulator, Interval};
-use schuler::sim::run::{ScenarioSpec, SimSink, simulate};
+use schuler::sim::receivers::{GnssModel, GnssSimulator, Interval};
+use schuler::sim::run::ScenarioSpec;
 use schuler::sim::vehicle::{HeadingSimulator, OdometerModel, OdometerSimulator, rest_intervals};
 use std::sync::OnceLock;
 
@@ -116,40 +116,25 @@ rate_hz = 100
 preset = "consumer-mems"
 "#;
 
-/// The exact increments and the truth at every sample.
+/// The exact increments and the truth at every sample's end, from the scenario's
+/// trajectory (the first sample ends one interval after its start).
 struct Data {
     exact: Vec<ImuSample>,
     truth: Vec<NavState>,
 }
 
-impl SimSink for Data {
-    fn imu(
-        &mut self,
-        exact: &ImuSample,
-        _m: &ImuSample,
-        truth: &NavState,
-        _kin: &Kinematics,
-    ) -> std::io::Result<()> {
-        self.exact.push(*exact);
-        self.truth.push(*truth);
-        Ok(())
-    }
-    fn gnss(&mut self, _f: &schuler::sim::receivers::GnssFix) -> std::io::Result<()> {
-        Ok(())
-    }
-    fn baro(&mut self, _b: &BaroReading) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
 fn simulated(text: &str) -> Data {
     let spec: ScenarioSpec = toml::from_str(text).expect("scenario");
-    let mut d = Data {
-        exact: Vec::new(),
-        truth: Vec::new(),
-    };
-    simulate(&spec, &mut d).expect("simulate");
-    d
+    let (traj, _) = spec.trajectory(Wgs84).expect("trajectory");
+    let dt = 1.0 / spec.imu.rate_hz;
+    let t0 = traj.start();
+    let n = ((traj.end() - t0) / dt).floor() as usize;
+    let exact: Vec<ImuSample> = analytic::samples(&Wgs84, &traj, t0, dt, n).collect();
+    let truth = exact
+        .iter()
+        .map(|s| analytic::state(&Wgs84, &traj, s.t))
+        .collect();
+    Data { exact, truth }
 }
 
 fn drive() -> &'static Data {
@@ -289,17 +274,10 @@ fn run_with(
 ) -> (Run, [Vector3<f64>; 3]) {
     let noise = ImuNoise::from_model(&model);
     let cfg = IntegrationConfig {
-        noise,
-        scale_factors: false,
-        lever_arm: Vector3::zeros(),
-        gate: Gate::Level(1e-4),
-        reset_after: 5,
-        propagation_interval: 1.0,
         init_pos_std: Vector3::repeat(0.3),
         init_vel_std: Vector3::repeat(0.05),
         init_att_std: Vector3::new(0.5, 0.5, 2.0).map(f64::to_radians),
-        init_sensor_std: None,
-        baro: None,
+        ..IntegrationConfig::new(noise)
     };
     let imu_attitude = |s: &NavState| s.q_bn * aids.imu_mount.inverse();
     let start = d.truth[0];

@@ -254,11 +254,7 @@ pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
 mod tests {
     use super::*;
 
-    fn file(text: &str) -> tempfile::NamedTempFile {
-        let f = tempfile::NamedTempFile::new().expect("temp");
-        std::fs::write(f.path(), text).expect("write");
-        f
-    }
+    use crate::formats::temp_file as file;
 
     #[test]
     fn reads_both_layouts_and_merges_velocity() {

@@ -69,11 +69,7 @@ pub fn read_heading(path: &Path) -> Result<Vec<HeadingReading>, InputError> {
 mod tests {
     use super::*;
 
-    fn file(text: &str) -> tempfile::NamedTempFile {
-        let f = tempfile::NamedTempFile::new().expect("temp");
-        std::fs::write(f.path(), text).expect("write");
-        f
-    }
+    use crate::formats::temp_file as file;
 
     #[test]
     fn reads_each_layout_with_or_without_a_header() {

@@ -41,3 +41,17 @@ pub fn rows(text: &str) -> Vec<Vec<f64>> {
 pub fn read_rows(path: &Path) -> Vec<Vec<f64>> {
     rows(&std::fs::read_to_string(path).expect("read"))
 }
+
+/// Run `schuler simulate` on `examples/drive.toml` (the 20-minute example drive) into
+/// `out`.
+pub fn simulate_example_drive(out: &Path) {
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drive.toml");
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["simulate", "--config"])
+        .arg(&example)
+        .arg("--out")
+        .arg(out)
+        .assert()
+        .success();
+}

@@ -74,6 +74,28 @@ pub struct IntegrationConfig {
     pub init_sensor_std: Option<[Vector3<f64>; 4]>,
 }
 
+impl IntegrationConfig {
+    /// The settings `schuler nav` starts from with this noise model: 15 states, no
+    /// lever arm or barometer, the gate at 1e-4 reset after 5 refusals in a row,
+    /// propagation every second, initial standard deviations 1 m, 0.1 m/s and
+    /// 0.1°, 0.1°, 0.5° (about north, east, down).
+    pub fn new(noise: ImuNoise) -> Self {
+        Self {
+            noise,
+            scale_factors: false,
+            lever_arm: Vector3::zeros(),
+            gate: Gate::Level(1e-4),
+            reset_after: 5,
+            propagation_interval: 1.0,
+            init_pos_std: Vector3::repeat(1.0),
+            init_vel_std: Vector3::repeat(0.1),
+            init_att_std: Vector3::new(0.1, 0.1, 0.5).map(f64::to_radians),
+            baro: None,
+            init_sensor_std: None,
+        }
+    }
+}
+
 /// A measurement the gate refused.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rejected {
