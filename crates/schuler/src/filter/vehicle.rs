@@ -16,9 +16,11 @@
 //!   (`C_vb`: body to vehicle): `v_v = C_vb (C_bc v_c + ω_eb × l)`, `ω_eb = ω_ib −
 //!   C_bc ω_ie^c`. Perturbed:
 //!   `δv_v = C_vb C_bc δv − C_vb (C_bc [v_c×] + [l×] C_bc [ω_ie^c×]) ψ
-//!   − C_vb [l×] (δb_g + diag(ω_ib) δs_g)` (Groves 2013 §16.2.3 and Shin 2005 §5.3
-//!   write the same for the phi-angle error and without the Earth-rate term, which is
-//!   below 1e-7 m/s per mrad of attitude error for a metre-long arm).
+//!   − C_vb [l×] (δb_g + diag(ω_ib) δs_g)` (the literature writes the same for the
+//!   phi-angle error and without the Earth-rate term, below 1e-7 m/s per mrad of
+//!   attitude error for a metre-long arm: Dissanayake et al. 2001, IEEE Trans.
+//!   Robotics and Automation 17(5); Groves 2013 ch. 15, zero updates and motion
+//!   constraints).
 //! - Non-holonomic constraint (NHC): a land vehicle's wheels neither slip sideways nor
 //!   leave the road, `z = (v̂_v,y, v̂_v,z) − 0`: rows 2 and 3 of `δv_v`.
 //! - Odometer speed `s = (1 + k) v_v,x + v` with a scale-factor error `k` (a state
