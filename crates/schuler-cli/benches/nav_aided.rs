@@ -87,6 +87,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
             html: false,
             ..Default::default()
         },
+        vehicle: Default::default(),
     };
     (settings, aiding)
 }

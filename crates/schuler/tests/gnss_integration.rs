@@ -7,9 +7,9 @@ use nalgebra::Vector3;
 use schuler::analysis::consistency::{ChiSquareTest, mean_bounds, normalized_squared};
 use schuler::analysis::errors::attitude_error;
 use schuler::earth::{EarthModel, Wgs84};
+use schuler::filter::ImuNoise;
 use schuler::filter::integration::{GnssFix, Innovation, IntegrationConfig, Integrator};
 use schuler::filter::measurement::Kind;
-use schuler::filter::{Gate, ImuNoise};
 use schuler::imu::ImuSample;
 use schuler::nav::{LocalLevel, NavState};
 use schuler::sim::analytic::Kinematics;
@@ -222,17 +222,12 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
     let model = tactical();
     let noise = ImuNoise::from_model(&model);
     let cfg = IntegrationConfig {
-        noise,
-        scale_factors: false,
         lever_arm: Vector3::from(LEVER),
-        gate: Gate::Level(1e-4),
-        reset_after: 5,
-        propagation_interval: 1.0,
         init_pos_std: Vector3::repeat(0.05),
         init_vel_std: Vector3::repeat(0.02),
         init_att_std: Vector3::new(0.05, 0.05, 0.2).map(f64::to_radians),
-        init_sensor_std: None,
         baro: baro.then_some((10.0, 0.0)),
+        ..IntegrationConfig::new(noise)
     };
     let mut baro_sim = schuler::sim::receivers::BaroSimulator::new(
         schuler::sim::receivers::BaroModel {

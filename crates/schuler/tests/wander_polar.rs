@@ -419,8 +419,8 @@ fn stationary_at_the_pole_stays_put() {
 /// unestimated 1 mg bias would drift, ½ · 9.81e-3 · 60² = 17.7 m.
 #[test]
 fn gnss_aided_flight_over_the_pole_keeps_mid_latitude_accuracy() {
+    use schuler::filter::ImuNoise;
     use schuler::filter::integration::{GnssFix, IntegrationConfig, Integrator};
-    use schuler::filter::{Gate, ImuNoise};
     use schuler::sim::imu_model::ImuSimulator;
     use schuler::sim::random::Noise;
     use schuler::sim::sensor_spec::{ImuSpec, Preset};
@@ -464,17 +464,10 @@ fn gnss_aided_flight_over_the_pole_keeps_mid_latitude_accuracy() {
         })
         .collect();
     let cfg = IntegrationConfig {
-        noise,
-        scale_factors: false,
-        lever_arm: Vector3::zeros(),
-        gate: Gate::Level(1e-4),
-        reset_after: 5,
-        propagation_interval: 1.0,
         init_pos_std: Vector3::repeat(0.05),
         init_vel_std: Vector3::repeat(0.02),
         init_att_std: Vector3::new(0.05, 0.05, 0.2).map(f64::to_radians),
-        init_sensor_std: None,
-        baro: None,
+        ..IntegrationConfig::new(noise)
     };
     let mech = start(earth, &traj, &exact, Wander::new);
     let mut integ = Integrator::new(mech, earth, cfg);

@@ -5,6 +5,7 @@
 //! `rejected.csv` (every measurement the gate refused or that fell outside the IMU
 //! data, with time and reason) and `innovations.csv` (every measurement tested, with
 //! its innovation, predicted standard deviations and NIS; [`super::aided_record`]).
+//! Vehicle aiding (ZUPT, NHC, odometer, dual-antenna heading) is in [`super::vehicle`].
 
 use super::aided_record::RunRecorder;
 use super::aided_report::{ReportData, ReportSettings, RunFacts};
@@ -67,6 +68,8 @@ pub struct Aiding {
     pub baro: Option<(Vec<(f64, f64)>, f64)>,
     /// The report: whether to write `report.html`, and the truths it compares with.
     pub report: ReportSettings,
+    /// Vehicle aiding.
+    pub vehicle: super::vehicle::VehicleAiding,
 }
 
 /// The outage test of `--outage-test`.
@@ -260,7 +263,7 @@ fn write_rejections<E: EarthModel, M: ErrorFrame>(
             SkipReason::BeforeImu => "before the IMU data",
             SkipReason::AfterImu => "after the IMU data",
         };
-        (k.t, format!("{},gnss,{why},,\n", k.t))
+        (k.t, format!("{},{},{why},,\n", k.t, k.kind))
     }));
     rows.extend(integ.gate_resets.iter().map(|t| {
         (*t, format!("{t},gnss_position,accepted without the gate after consecutive refusals (filter reset),,\n"))
@@ -315,8 +318,10 @@ where
         settings.init_vel,
         settings.init_att,
     );
-    let mut integ = Integrator::new(M::start(earth, init), earth, aiding.config)
-        .with_estimates(aiding.initial_errors);
+    let mut integ = aiding.vehicle.configure(
+        Integrator::new(M::start(earth, init), earth, aiding.config)
+            .with_estimates(aiding.initial_errors),
+    );
     if aiding.smooth {
         integ = integ.with_smoother();
     }
@@ -334,6 +339,7 @@ where
     let mut last_t = first.t;
     let mut failure = None;
     let mut next_baro = 0usize;
+    let mut vehicle = aiding.vehicle.start();
     for s in samples.by_ref() {
         let s = match s {
             Ok(s) => s,
@@ -353,6 +359,7 @@ where
                 next_baro += 1;
             }
         }
+        vehicle.after_sample(&mut integ, &s);
         recorder.after_sample(&mut integ, s.t, s.dt)?;
         n += 1;
         last_t = s.t;
@@ -367,6 +374,7 @@ where
     for f in fixes {
         integ.skip(f.t, SkipReason::AfterImu);
     }
+    vehicle.finish(&mut integ);
     let epochs = writer.finish()?;
     std.finish()?;
     err.finish()?;
@@ -537,13 +545,86 @@ pub struct AidingOptions {
     /// propagated to each measurement's time).
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
     pub propagation_interval: Option<String>,
+    /// Zero-velocity updates inside the rest intervals of FILE (`t0 t1` per line).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_name = "FILE",
+        conflicts_with = "zupt_detect"
+    )]
+    pub zupt: Option<PathBuf>,
+    /// Zero-velocity updates where the IMU data look at rest (the alignment's motion
+    /// detector on a 1-s window, specific force against gravity, rate against the
+    /// Earth's) and the navigation's speed is below --zupt-max-speed.
+    #[arg(long)]
+    #[serde(default)]
+    pub zupt_detect: bool,
+    /// Zero-velocity standard deviation (default 0.02 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub zupt_std: Option<String>,
+    /// Time between zero-velocity updates at rest, and the detector's block
+    /// (default 0.1 s; the detector's window is ten blocks).
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub zupt_interval: Option<String>,
+    /// --zupt-detect: no update while the navigation's speed exceeds this (an IMU
+    /// cannot tell rest from constant velocity; default 0.5 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub zupt_max_speed: Option<String>,
+    /// With each zero-velocity update, a zero-angular-rate update on the gyro biases
+    /// (the body turns with the Earth only).
+    #[arg(long)]
+    #[serde(default)]
+    pub zaru: bool,
+    /// Standard deviation of the rate averaged over --zupt-interval (default: the angle
+    /// random walk over that time, ARW/sqrt(interval)).
+    #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    pub zaru_std: Option<String>,
+    /// Non-holonomic constraint of a land vehicle: no lateral or vertical velocity of
+    /// the vehicle frame at --vehicle-lever-arm.
+    #[arg(long)]
+    #[serde(default)]
+    pub nhc: bool,
+    /// NHC standard deviation (default 0.1 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub nhc_std: Option<String>,
+    /// Time between NHC updates (default 0.1 s).
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub nhc_interval: Option<String>,
+    /// Odometer log (`t speed` per line, forward speed in m/s at --vehicle-lever-arm).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub odometer: Option<PathBuf>,
+    /// Odometer speed standard deviation (default 0.05 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub odometer_std: Option<String>,
+    /// Estimate the odometer's scale factor with this prior standard deviation (e.g.
+    /// `1 %`).
+    #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    pub odometer_scale_std: Option<String>,
+    /// Mounting angles: the vehicle frame's roll, pitch, yaw relative to the IMU body
+    /// [deg] (0,0,0 when the IMU's axes are the vehicle's front, right, down).
+    #[arg(long, allow_hyphen_values = true, value_name = "R,P,Y")]
+    pub mounting_angles: Option<super::nav::Triple>,
+    /// The point the NHC and the odometer speak of (the rear axle's centre, the
+    /// odometer wheel) in IMU body axes, front, right, down [m] (default 0,0,0).
+    #[arg(long, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    pub vehicle_lever_arm: Option<super::nav::Triple>,
+    /// Dual-antenna GNSS headings (`t heading std [pitch pitch_std]`, degrees).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub dual_antenna: Option<PathBuf>,
+    /// Azimuth of the antenna baseline (from the first antenna to the second) from
+    /// the IMU's front axis towards its right [deg] (default 0).
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub dual_antenna_baseline_yaw: Option<f64>,
+    /// Elevation of the baseline above the IMU's front-right plane [deg] (default 0).
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub dual_antenna_baseline_pitch: Option<f64>,
 }
 
 impl AidingOptions {
     /// `self` with missing fields taken from `other`.
     pub fn or(self, other: AidingOptions) -> AidingOptions {
         macro_rules! pick {
-            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth, no_report: self.no_report || other.no_report } };
+            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth, no_report: self.no_report || other.no_report, zupt_detect: self.zupt_detect || other.zupt_detect, zaru: self.zaru || other.zaru, nhc: self.nhc || other.nhc } };
         }
         pick!(
             gnss,
@@ -570,7 +651,22 @@ impl AidingOptions {
             outage_start,
             truth,
             sensor_truth,
-            propagation_interval
+            propagation_interval,
+            zupt,
+            zupt_std,
+            zupt_interval,
+            zupt_max_speed,
+            zaru_std,
+            nhc_std,
+            nhc_interval,
+            odometer,
+            odometer_std,
+            odometer_scale_std,
+            mounting_angles,
+            vehicle_lever_arm,
+            dual_antenna,
+            dual_antenna_baseline_yaw,
+            dual_antenna_baseline_pitch
         )
     }
 
@@ -581,6 +677,10 @@ impl AidingOptions {
             &mut self.gnss_vel,
             &mut self.truth,
             &mut self.sensor_truth,
+            &mut self.baro,
+            &mut self.zupt,
+            &mut self.odometer,
+            &mut self.dual_antenna,
         ]
         .into_iter()
         .flatten()
@@ -592,24 +692,33 @@ impl AidingOptions {
         self
     }
 
-    /// Load the GNSS data and check every value; `None` without `--gnss`.
+    /// Whether any aiding source is given (GNSS, barometer or a vehicle aid).
+    pub fn any(&self) -> bool {
+        self.gnss.is_some()
+            || self.baro.is_some()
+            || self.zupt.is_some()
+            || self.zupt_detect
+            || self.nhc
+            || self.odometer.is_some()
+            || self.dual_antenna.is_some()
+    }
+
+    /// Load the aiding data and check every value; `None` without any aiding source
+    /// ([`AidingOptions::any`]).
     pub fn resolve(&self, noise: schuler::filter::ImuNoise) -> Result<Option<Aiding>> {
         use schuler::units::{Dimension, parse_as_or_si};
-        let Some(gnss) = &self.gnss else {
-            if self.gnss_vel.is_some() {
-                bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
-            }
+        if self.gnss.is_none() && self.gnss_vel.is_some() {
+            bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
+        }
+        super::vehicle::check_dependencies(self)?;
+        if !self.any() {
             return Ok(None);
+        }
+        let q = quantity;
+        let mut fixes = match &self.gnss {
+            Some(gnss) => crate::formats::gnss::read_gnss(gnss)?,
+            None => Vec::new(),
         };
-        let q = |flag: &str, v: &Option<String>, dim: Dimension| -> Result<Option<f64>> {
-            let Some(s) = v else { return Ok(None) };
-            let x = parse_as_or_si(s, dim).with_context(|| format!("--{flag} {s:?}"))?;
-            if !(x.is_finite() && x >= 0.0) {
-                bail!("--{flag} must not be negative, got {s:?}");
-            }
-            Ok(Some(x))
-        };
-        let mut fixes = crate::formats::gnss::read_gnss(gnss)?;
         if let Some(v) = &self.gnss_vel {
             let std = q("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
             if std <= 0.0 {
@@ -755,7 +864,9 @@ impl AidingOptions {
         if propagation_interval <= 0.0 {
             bail!("--propagation-interval must be positive");
         }
+        let vehicle = super::vehicle::resolve(self, &noise)?;
         Ok(Some(Aiding {
+            vehicle,
             smooth: self.smooth,
             names: OutputNames::SCHULER,
             initial_errors: Default::default(),
@@ -791,6 +902,21 @@ impl AidingOptions {
             },
         }))
     }
+}
+
+/// The value of an aiding option given with a unit (or as a bare SI number), checked
+/// finite and not negative; errors name the flag.
+pub(super) fn quantity(
+    flag: &str,
+    v: &Option<String>,
+    dim: schuler::units::Dimension,
+) -> Result<Option<f64>> {
+    let Some(s) = v else { return Ok(None) };
+    let x = schuler::units::parse_as_or_si(s, dim).with_context(|| format!("--{flag} {s:?}"))?;
+    if !(x.is_finite() && x >= 0.0) {
+        bail!("--{flag} must not be negative, got {s:?}");
+    }
+    Ok(Some(x))
 }
 
 /// The outage test's report: the outages, and with a truth the largest horizontal,

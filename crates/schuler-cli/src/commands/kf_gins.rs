@@ -193,12 +193,13 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         outage_test: None,
         baro: None,
         report: super::aided_report::ReportSettings::default(),
+        vehicle: Default::default(),
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
             accel_bias: Vector3::from(y.initaccbias) * MGAL,
             gyro_scale: Vector3::from(y.initgyrscale) * PPM,
             accel_scale: Vector3::from(y.initaccscale) * PPM,
-            baro_bias: 0.0,
+            ..SensorEstimates::default()
         },
     };
     Ok(KfGinsRun { settings, aiding })

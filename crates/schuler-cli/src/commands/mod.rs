@@ -12,4 +12,5 @@ pub mod kf_gins;
 pub mod nav;
 pub mod platform;
 pub mod simulate;
+pub mod vehicle;
 pub mod vertical;

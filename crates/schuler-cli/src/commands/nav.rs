@@ -812,13 +812,11 @@ pub fn run(args: NavArgs) -> Result<()> {
     // navigation grade for alignment (gyrocompassing needs it) but tactical for the
     // filter: an optimistic noise model makes the gate refuse good fixes, a
     // pessimistic one only costs a little accuracy.
-    let grade = align_opts
-        .imu_grade
-        .unwrap_or(if aiding_opts.gnss.is_some() {
-            super::align::GradeChoice::Tactical
-        } else {
-            super::align::GradeChoice::Navigation
-        });
+    let grade = align_opts.imu_grade.unwrap_or(if aiding_opts.any() {
+        super::align::GradeChoice::Tactical
+    } else {
+        super::align::GradeChoice::Navigation
+    });
     let align = align_on.then(|| align_opts.resolve()).transpose()?;
     let aiding: Option<Aiding> = aiding_opts.resolve(grade.noise()?)?;
     // With aiding there is no hand-over: `auto` picks the wander mechanization when
@@ -919,6 +917,9 @@ pub fn run(args: NavArgs) -> Result<()> {
             summary.mean_nis_per_dof
         );
         print!("{}", summary.report_text);
+        if let Some(line) = super::vehicle::summary(&c) {
+            println!("{line}");
+        }
         if let Some(test) = &aiding.outage_test {
             super::aided::report_outage_test(
                 &settings.out.join("nav.txt"),
@@ -927,10 +928,18 @@ pub fn run(args: NavArgs) -> Result<()> {
                 &settings.out,
             )?;
         }
-        let tried = c.position + c.velocity + c.rejected;
+        let tried = c.position
+            + c.velocity
+            + c.baro
+            + c.zupt
+            + c.zaru
+            + c.nhc
+            + c.odometer
+            + c.heading
+            + c.rejected;
         if c.rejected * 10 > tried {
             eprintln!(
-                "warning: the gate refused {} of {} GNSS measurements: the IMU noise model is probably too optimistic for this sensor (--imu-grade, --arw, --gyro-bias-std, ...)",
+                "warning: the gate refused {} of {} measurements (see rejected.csv): the IMU noise model is probably too optimistic for this sensor (--imu-grade, --arw, --gyro-bias-std, ...)",
                 c.rejected, tried
             );
         }

@@ -15,12 +15,16 @@ const POS_FIELDS: [&str; 13] = [
 ];
 const VEL_FIELDS: [&str; 7] = ["time", "vn", "ve", "vd", "std_vn", "std_ve", "std_vd"];
 
-/// Numbers of each data line (blank lines and `#`/`%` comments skipped), with their
-/// 1-based line numbers; checks column counts, finiteness and increasing time.
+/// Numbers of each data line (blank lines and `#`/`%` comments skipped, and with
+/// `header` a first line that starts with a letter), with their 1-based line numbers;
+/// checks column counts (one of `counts`), finiteness, positive standard deviations
+/// (fields named `std*`) and increasing time (the first column). Small logs only: the
+/// file is read whole.
 pub(crate) fn numeric_rows(
     path: &Path,
     names: &[&str],
     counts: &[usize],
+    header: bool,
 ) -> Result<Vec<(u64, Vec<f64>)>, InputError> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         InputError::new(
@@ -35,7 +39,11 @@ pub(crate) fn numeric_rows(
     for (i, line) in text.lines().enumerate() {
         let n = i as u64 + 1;
         let l = line.trim();
-        if l.is_empty() || l.starts_with('#') || l.starts_with('%') {
+        if l.is_empty()
+            || l.starts_with('#')
+            || l.starts_with('%')
+            || (header && n == 1 && l.starts_with(|c: char| c.is_ascii_alphabetic()))
+        {
             continue;
         }
         let fields: Vec<&str> = l
@@ -109,7 +117,7 @@ pub(crate) fn numeric_rows(
 
 /// Read a GNSS position log (7 or 13 columns).
 pub fn read_gnss(path: &Path) -> Result<Vec<GnssFix>, InputError> {
-    let rows = numeric_rows(path, &POS_FIELDS, &[7, 13])?;
+    let rows = numeric_rows(path, &POS_FIELDS, &[7, 13], false)?;
     let mut fixes = Vec::with_capacity(rows.len());
     for (n, v) in rows {
         if !(-90.0..=90.0).contains(&v[1]) {
@@ -144,7 +152,7 @@ pub fn merge_velocity(
     path: &Path,
     default_std: f64,
 ) -> Result<usize, InputError> {
-    let rows = numeric_rows(path, &VEL_FIELDS, &[4, 7])?;
+    let rows = numeric_rows(path, &VEL_FIELDS, &[4, 7], false)?;
     let mut unmatched = 0;
     let mut j = 0;
     for (_, v) in rows {
@@ -246,11 +254,7 @@ pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
 mod tests {
     use super::*;
 
-    fn file(text: &str) -> tempfile::NamedTempFile {
-        let f = tempfile::NamedTempFile::new().expect("temp");
-        std::fs::write(f.path(), text).expect("write");
-        f
-    }
+    use crate::formats::temp_file as file;
 
     #[test]
     fn reads_both_layouts_and_merges_velocity() {

@@ -11,6 +11,15 @@ pub mod imu_log;
 mod lines;
 pub mod nav;
 pub mod sensor_errors;
+pub mod vehicle;
 
 pub use error::InputError;
 pub use imu_log::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};
+
+/// A temporary file holding `text`, for the readers' tests.
+#[cfg(test)]
+pub(crate) fn temp_file(text: &str) -> tempfile::NamedTempFile {
+    let f = tempfile::NamedTempFile::new().expect("temp");
+    std::fs::write(f.path(), text).expect("write");
+    f
+}

@@ -17,7 +17,7 @@ const FIELDS: [&str; 13] = [
 /// Reads a sensor-error file whole: `(t, errors)` in time order, SI units (scale
 /// factors zero where the file has 7 columns).
 pub fn read_sensor_errors(path: &Path) -> Result<Vec<(f64, SensorEstimates)>, InputError> {
-    let rows = super::gnss::numeric_rows(path, &FIELDS, &[7, 13])?;
+    let rows = super::gnss::numeric_rows(path, &FIELDS, &[7, 13], false)?;
     Ok(rows
         .into_iter()
         .map(|(_, v)| {

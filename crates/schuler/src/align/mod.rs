@@ -10,14 +10,19 @@
 //!    predicted, and gyrocompassing is refused past a limit.
 //! 3. [`fine`]: the Kalman filter on the invariants, started from the coarse result
 //!    with a prior that carries the coarse errors' correlation with the sensor biases.
+//!
+//! [`rest`] runs the same motion detector on a stream to find rests for
+//! zero-velocity updates during navigation.
 
 pub mod coarse;
 pub mod fine;
 pub mod prefilter;
+pub mod rest;
 
 pub use coarse::{CoarseAlignment, HeadingSource};
 pub use fine::{Convergence, FineAlignment, FineConfig};
 pub use prefilter::{MotionReport, Spike};
+pub use rest::{Gravity, RestDetector, RestVerdict};
 
 use crate::earth::{EarthModel, Geodetic};
 use crate::filter::kalman::duplicate_states;

@@ -135,6 +135,54 @@ pub struct MotionReport {
 /// 3× with negligible probability).
 pub const MOTION_FACTOR: f64 = 3.0;
 
+/// Sums over one block of samples: what the motion detector needs of it, gathered
+/// in one pass (Welford's update for the scatter), so a detector can run on a stream.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BlockSums {
+    /// Samples.
+    pub n: usize,
+    /// `Σ dt` [s].
+    pub t: f64,
+    /// `Σ dθ` [rad].
+    pub dtheta: Vector3<f64>,
+    /// `Σ dv` [m/s].
+    pub dvel: Vector3<f64>,
+    /// Running mean of the samples' specific force `dv/dt` [m/s^2].
+    mean_f: Vector3<f64>,
+    /// `Σ (dv/dt − mean_f)²` [m²/s⁴].
+    m2_f: Vector3<f64>,
+}
+
+impl BlockSums {
+    /// Add one sample.
+    pub fn add(&mut self, s: &ImuSample) {
+        self.n += 1;
+        self.t += s.dt;
+        self.dtheta += s.dtheta;
+        self.dvel += s.dvel;
+        let f = s.dvel / s.dt;
+        let d = f - self.mean_f;
+        self.mean_f += d / self.n as f64;
+        self.m2_f += d.component_mul(&(f - self.mean_f));
+    }
+
+    /// Mean angular rate `Σ dθ / Σ dt` [rad/s].
+    pub fn rate(&self) -> Vector3<f64> {
+        self.dtheta / self.t
+    }
+
+    /// Mean specific force `Σ dv / Σ dt` [m/s^2].
+    pub fn force(&self) -> Vector3<f64> {
+        self.dvel / self.t
+    }
+
+    /// `Σ (dv/dt − a)²` about the block's mean force `a` (`Σ (f − f̄)² + n (f̄ − a)²`).
+    fn scatter_about_force(&self) -> Vector3<f64> {
+        let d = self.mean_f - self.force();
+        self.m2_f + d.component_mul(&d) * self.n as f64
+    }
+}
+
 /// Analyse the blocks of a (spike-free) stationary record.
 pub fn detect_motion(
     samples: &[ImuSample],
@@ -142,56 +190,57 @@ pub fn detect_motion(
     arw: &Vector3<f64>,
     vrw: &Vector3<f64>,
 ) -> MotionReport {
-    let mut means_g = Vec::new();
-    let mut means_a = Vec::new();
-    let mut within = Vector3::zeros();
-    let mut within_n = 0usize;
-    let mut block_t = 0.0;
-    let mut dt_sum = 0.0;
-    let mut dt_n = 0usize;
-    for chunk in samples.chunks(block.max(1)) {
-        if chunk.len() < block.max(1) {
-            break;
-        }
-        let t: f64 = chunk.iter().map(|s| s.dt).sum();
-        let g: Vector3<f64> = chunk.iter().map(|s| s.dtheta).sum::<Vector3<f64>>() / t;
-        let a: Vector3<f64> = chunk.iter().map(|s| s.dvel).sum::<Vector3<f64>>() / t;
-        for s in chunk {
-            let d = s.dvel / s.dt - a;
-            within += d.component_mul(&d);
-            within_n += 1;
-            dt_sum += s.dt;
-            dt_n += 1;
-        }
-        means_g.push(g);
-        means_a.push(a);
-        block_t += t;
-    }
-    let nb = means_g.len().max(1) as f64;
-    let scatter = |means: &[Vector3<f64>]| {
-        let mean = means.iter().sum::<Vector3<f64>>() / nb;
-        (means
+    let blocks: Vec<BlockSums> = samples
+        .chunks_exact(block.max(1))
+        .map(|chunk| {
+            let mut b = BlockSums::default();
+            chunk.iter().for_each(|s| b.add(s));
+            b
+        })
+        .collect();
+    motion_of_blocks(&blocks, arw, vrw)
+}
+
+/// The motion detector on blocks already summed (see the module doc).
+pub fn motion_of_blocks(
+    blocks: &[BlockSums],
+    arw: &Vector3<f64>,
+    vrw: &Vector3<f64>,
+) -> MotionReport {
+    let nb = blocks.len().max(1) as f64;
+    let mean_of =
+        |m: &dyn Fn(&BlockSums) -> Vector3<f64>| blocks.iter().map(m).sum::<Vector3<f64>>() / nb;
+    let scatter = |m: &dyn Fn(&BlockSums) -> Vector3<f64>| {
+        let mean = mean_of(m);
+        (blocks
             .iter()
-            .map(|m| (m - mean).component_mul(&(m - mean)))
+            .map(|b| (m(b) - mean).component_mul(&(m(b) - mean)))
             .sum::<Vector3<f64>>()
             / nb)
             .map(f64::sqrt)
     };
+    let block_t = blocks.iter().map(|b| b.t).sum::<f64>();
+    let samples = blocks.iter().map(|b| b.n).sum::<usize>();
     let t_block = block_t / nb;
-    let wander = |means: &[Vector3<f64>]| {
-        let mean = means.iter().sum::<Vector3<f64>>() / nb;
+    let wander = |m: &dyn Fn(&BlockSums) -> Vector3<f64>| {
+        let mean = mean_of(m);
         let mut sum = Vector3::zeros();
         let mut sq = Vector3::zeros();
-        for m in means {
-            sum += (m - mean) * t_block;
+        for b in blocks {
+            sum += (m(b) - mean) * t_block;
             sq += sum.component_mul(&sum);
         }
         (sq / nb).map(f64::sqrt)
     };
-    let dt = if dt_n > 0 { dt_sum / dt_n as f64 } else { 1.0 };
-    let gyro_block_scatter = scatter(&means_g);
+    let within: Vector3<f64> = blocks.iter().map(BlockSums::scatter_about_force).sum();
+    let dt = if samples > 0 {
+        block_t / samples as f64
+    } else {
+        1.0
+    };
+    let gyro_block_scatter = scatter(&BlockSums::rate);
     let gyro_block_noise = arw / t_block.max(f64::MIN_POSITIVE).sqrt();
-    let accel_sample_scatter = (within / within_n.max(1) as f64).map(f64::sqrt);
+    let accel_sample_scatter = (within / samples.max(1) as f64).map(f64::sqrt);
     let accel_sample_noise = vrw / dt.sqrt();
     let exceeds = |x: &Vector3<f64>, n: &Vector3<f64>| {
         (0..3).any(|i| x[i] > MOTION_FACTOR * n[i].max(f64::MIN_POSITIVE))
@@ -201,10 +250,10 @@ pub fn detect_motion(
         gyro_block_noise,
         accel_sample_scatter,
         accel_sample_noise,
-        accel_block_scatter: scatter(&means_a),
-        attitude_wander: wander(&means_g),
-        velocity_wander: wander(&means_a),
-        angular_motion: means_g.len() >= 2 && exceeds(&gyro_block_scatter, &gyro_block_noise),
+        accel_block_scatter: scatter(&BlockSums::force),
+        attitude_wander: wander(&BlockSums::rate),
+        velocity_wander: wander(&BlockSums::force),
+        angular_motion: blocks.len() >= 2 && exceeds(&gyro_block_scatter, &gyro_block_noise),
         vibration: exceeds(&accel_sample_scatter, &accel_sample_noise),
     }
 }

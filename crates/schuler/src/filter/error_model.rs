@@ -6,8 +6,9 @@
 //!   `G = (g/r) diag(−1, −1, 2)` (gravity gradient, down positive)
 //! - `ψ̇ = −(ω_ie + ρ)×ψ − Ĉ_cb (δb_g + diag(ω^b) δs_g)`
 //! - residual biases: random walks or Gauss–Markov, `ḃ = −b/τ + w` ([`super::noise`]);
-//!   scale factors, the baro bias and
-//!   the reference attitude: constants (the baro bias with an optional walk).
+//!   scale factors, the baro bias, the odometer scale factor and
+//!   the reference attitude: constants (the baro bias and the odometer scale factor
+//!   with an optional walk).
 //!
 //! `ρ` is the transport rate of `c` (with zero vertical component in the wander frame),
 //! so nothing here is singular at a pole (Savage 2000, §12.2; Titterton & Weston 2004,
@@ -47,6 +48,8 @@ pub struct ErrorModel {
     pub noise: ImuNoise,
     /// Barometer bias random-walk density [m/sqrt(s)].
     pub baro_bias_walk: f64,
+    /// Odometer scale-factor random-walk density [1/sqrt(s)].
+    pub odometer_scale_walk: f64,
 }
 
 fn put(m: &mut DMatrix<f64>, r: usize, c: usize, b: &Matrix3<f64>) {
@@ -125,6 +128,9 @@ impl ErrorModel {
         );
         if let Some(b) = l.baro_bias {
             q[(b, b)] = self.baro_bias_walk * self.baro_bias_walk;
+        }
+        if let Some(o) = l.odometer_scale {
+            q[(o, o)] = self.odometer_scale_walk * self.odometer_scale_walk;
         }
         if nz.scale_tau.is_finite() {
             // Gauss–Markov scale factors: density 2σ²/τ.

@@ -9,6 +9,13 @@
 //! fix that falls inside a sample's interval splits the sample there (increments
 //! divided in proportion to time, the constant-rate assumption over one sample), so
 //! the update happens at the fix's own time.
+//!
+//! Vehicle measurements ([`super::vehicle`]) apply at the instant the caller calls
+//! them, after a sample: zero velocity and rate and the non-holonomic constraint hold
+//! at any instant of a rest or a drive, so the sample's end is their time; an odometer
+//! or heading reading is applied at the sample ending nearest its time (at most half
+//! a sample away: at 200 Hz, 2.5 ms, or 2.5 mm/s of speed at 1 m/s² — the heading is
+//! carried over the offset with the body rate).
 
 use super::error_model::ErrorModel;
 use super::interval::Interval;
@@ -16,6 +23,7 @@ use super::kalman::{Gate, Kalman, Rejection};
 use super::layout::Layout;
 use super::measurement::{self, Kind, Measurement};
 use super::noise::ImuNoise;
+use super::vehicle::{self, Baseline, HeadingReading, VehicleMount};
 use crate::earth::{EarthModel, Geodetic};
 use crate::imu::ImuSample;
 use crate::nav::{ErrorFrame, NavErrors, NavState};
@@ -66,6 +74,28 @@ pub struct IntegrationConfig {
     pub init_sensor_std: Option<[Vector3<f64>; 4]>,
 }
 
+impl IntegrationConfig {
+    /// The settings `schuler nav` starts from with this noise model: 15 states, no
+    /// lever arm or barometer, the gate at 1e-4 reset after 5 refusals in a row,
+    /// propagation every second, initial standard deviations 1 m, 0.1 m/s and
+    /// 0.1°, 0.1°, 0.5° (about north, east, down).
+    pub fn new(noise: ImuNoise) -> Self {
+        Self {
+            noise,
+            scale_factors: false,
+            lever_arm: Vector3::zeros(),
+            gate: Gate::Level(1e-4),
+            reset_after: 5,
+            propagation_interval: 1.0,
+            init_pos_std: Vector3::repeat(1.0),
+            init_vel_std: Vector3::repeat(0.1),
+            init_att_std: Vector3::new(0.1, 0.1, 0.5).map(f64::to_radians),
+            baro: None,
+            init_sensor_std: None,
+        }
+    }
+}
+
 /// A measurement the gate refused.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rejected {
@@ -103,6 +133,8 @@ pub struct Innovation {
 pub struct Skipped {
     /// Time [s].
     pub t: f64,
+    /// What it was.
+    pub kind: Kind,
     /// Why.
     pub reason: SkipReason,
 }
@@ -129,6 +161,8 @@ pub struct SensorEstimates {
     pub accel_scale: Vector3<f64>,
     /// Barometer bias [m].
     pub baro_bias: f64,
+    /// Odometer scale-factor error (reading = (1 + k) speed).
+    pub odometer_scale: f64,
 }
 
 impl SensorEstimates {
@@ -152,10 +186,36 @@ pub struct Counts {
     pub velocity: u64,
     /// Accepted barometer updates.
     pub baro: u64,
+    /// Accepted zero-velocity updates.
+    pub zupt: u64,
+    /// Accepted zero-angular-rate updates.
+    pub zaru: u64,
+    /// Accepted non-holonomic constraints.
+    pub nhc: u64,
+    /// Accepted odometer speeds.
+    pub odometer: u64,
+    /// Accepted dual-antenna headings.
+    pub heading: u64,
     /// Rejected by the gate.
     pub rejected: u64,
     /// Not usable (outside the IMU's time span).
     pub skipped: u64,
+}
+
+impl Counts {
+    /// Count an accepted measurement of `kind`.
+    pub fn accept(&mut self, kind: Kind) {
+        *match kind {
+            Kind::GnssPosition => &mut self.position,
+            Kind::GnssVelocity => &mut self.velocity,
+            Kind::BaroHeight => &mut self.baro,
+            Kind::ZeroVelocity => &mut self.zupt,
+            Kind::ZeroRate => &mut self.zaru,
+            Kind::NonHolonomic => &mut self.nhc,
+            Kind::Odometer => &mut self.odometer,
+            Kind::Heading => &mut self.heading,
+        } += 1;
+    }
 }
 
 /// The integrated navigation: mechanization plus filter.
@@ -204,6 +264,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             layout,
             noise: cfg.noise,
             baro_bias_walk: baro_walk,
+            odometer_scale_walk: 0.0,
         };
         let frame = mech.frame();
         let state = mech.state();
@@ -260,6 +321,27 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     /// Start from sensor-error estimates other than zero (e.g. a previous run's).
     pub fn with_estimates(mut self, estimates: SensorEstimates) -> Self {
         self.estimates = estimates;
+        self
+    }
+
+    /// Estimate the odometer's scale-factor error: prior standard deviation `std` and
+    /// random-walk density `walk` [1/sqrt(s)] (a state appended to the layout; the
+    /// smoother's record, if any, restarts with the larger covariance).
+    pub fn with_odometer_scale(mut self, std: f64, walk: f64) -> Self {
+        if self.model.layout.odometer_scale.is_some() {
+            return self;
+        }
+        let old = self.model.layout.n;
+        self.model.layout = self.model.layout.with_odometer_scale();
+        self.model.odometer_scale_walk = walk;
+        let n = self.model.layout.n;
+        let mut p = DMatrix::zeros(n, n);
+        p.view_mut((0, 0), (old, old)).copy_from(&self.kf.p);
+        p[(old, old)] = std * std;
+        self.kf.p = p;
+        if self.smoother.is_some() {
+            self = self.with_smoother();
+        }
         self
     }
 
@@ -407,10 +489,15 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
     }
 
-    /// Record a measurement that could not be used.
+    /// Record a GNSS fix that could not be used.
     pub fn skip(&mut self, t: f64, reason: SkipReason) {
+        self.skip_measurement(t, Kind::GnssPosition, reason);
+    }
+
+    /// Record a measurement of `kind` that could not be used.
+    pub fn skip_measurement(&mut self, t: f64, kind: Kind, reason: SkipReason) {
         self.counts.skipped += 1;
-        self.skipped.push(Skipped { t, reason });
+        self.skipped.push(Skipped { t, kind, reason });
     }
 
     /// Apply a GNSS fix now (position, then velocity if present).
@@ -470,11 +557,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
                 if position {
                     self.consecutive_rejections = 0;
                 }
-                match m.kind {
-                    Kind::GnssPosition => self.counts.position += 1,
-                    Kind::GnssVelocity => self.counts.velocity += 1,
-                    Kind::BaroHeight => self.counts.baro += 1,
-                }
+                self.counts.accept(m.kind);
                 self.feed_back(&u.dx);
                 if let Some(log) = self.smoother.as_mut() {
                     log.feedback(&u.dx, &self.kf.p);
@@ -515,6 +598,9 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if let Some(b) = l.baro_bias {
             self.estimates.baro_bias += dx[b];
         }
+        if let Some(o) = l.odometer_scale {
+            self.estimates.odometer_scale += dx[o];
+        }
     }
 
     /// Apply a barometric height `h_baro` [m] with standard deviation `std` now (the
@@ -530,6 +616,77 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         };
         self.propagate();
         self.apply(t, m)
+    }
+}
+
+impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
+    /// Zero velocity now (the vehicle at rest), standard deviation `std` [m/s] per
+    /// axis ([`vehicle::zero_velocity`]).
+    pub fn update_zero_velocity(&mut self, std: f64) -> bool {
+        self.propagate();
+        let frame = self.mech.frame();
+        let m = vehicle::zero_velocity(&self.model.layout, &frame, std);
+        self.apply(frame.t, m)
+    }
+
+    /// Zero angular rate relative to the Earth now, from `window`: the raw increments
+    /// summed over a window at rest that ends now (compensated here with the current
+    /// estimates), standard deviation `std` [rad/s] per axis of the window's mean
+    /// rate ([`vehicle::zero_rate`]).
+    pub fn update_zero_rate(&mut self, window: &ImuSample, std: f64) -> bool {
+        if window.dt <= 0.0 {
+            return false;
+        }
+        self.propagate();
+        let frame = self.mech.frame();
+        let w = self.estimates.compensate(window).dtheta / window.dt;
+        let m = vehicle::zero_rate(&self.model.layout, &frame, &w, std);
+        self.apply(frame.t, m)
+    }
+
+    /// The non-holonomic constraint now: no lateral or vertical velocity of `mount`'s
+    /// point, standard deviation `std` [m/s] ([`vehicle::non_holonomic`]).
+    pub fn update_non_holonomic(&mut self, mount: &VehicleMount, std: f64) -> bool {
+        self.propagate();
+        let frame = self.mech.frame();
+        let m = vehicle::non_holonomic(&self.model.layout, &frame, mount, &self.w_ib_b, std);
+        self.apply(frame.t, m)
+    }
+
+    /// An odometer `speed` [m/s] read at `t` of `mount`'s point, standard deviation
+    /// `std`, applied now (at the sample ending nearest `t`; [`vehicle::odometer`]).
+    pub fn update_odometer(&mut self, t: f64, speed: f64, std: f64, mount: &VehicleMount) -> bool {
+        self.propagate();
+        let m = vehicle::odometer(
+            &self.model.layout,
+            &self.mech.frame(),
+            mount,
+            &self.w_ib_b,
+            speed,
+            self.estimates.odometer_scale,
+            std,
+        );
+        self.apply(t, m)
+    }
+
+    /// A dual-antenna heading `reading` of `baseline`, applied now (at the sample
+    /// ending nearest its time, the computed heading carried to it with the body
+    /// rate; [`vehicle::heading`]). Refused (false) for a vertical baseline.
+    pub fn update_heading(&mut self, reading: &HeadingReading, baseline: &Baseline) -> bool {
+        let frame = self.mech.frame();
+        let at = self.mech.state().pos;
+        let Some(m) = vehicle::heading(
+            &self.model.layout,
+            &frame,
+            &at,
+            baseline,
+            &self.w_ib_b,
+            reading,
+        ) else {
+            return false;
+        };
+        self.propagate();
+        self.apply(reading.t, m)
     }
 }
 

@@ -3,8 +3,8 @@
 
 /// Offsets of the error states. The first fifteen are always present:
 /// `δr` (0..3), `δv` (3..6), `ψ` (6..9), residual gyro bias (9..12) and accelerometer
-/// bias (12..15); optional blocks follow in the order scale factors (gyro, then
-/// accelerometer), barometer bias, reference attitude.
+/// bias (12..15); optional blocks follow in the order they are added (the builders
+/// below), each at the offset it records.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Layout {
     /// Number of states.
@@ -18,6 +18,8 @@ pub struct Layout {
     /// Attitude error at a reference time (3), for the "attitude unchanged" invariant of
     /// a stationary base.
     pub attitude_ref: Option<usize>,
+    /// Odometer scale-factor error (1), if estimated.
+    pub odometer_scale: Option<usize>,
 }
 
 impl Layout {
@@ -40,6 +42,7 @@ impl Layout {
             accel_scale: None,
             baro_bias: None,
             attitude_ref: None,
+            odometer_scale: None,
         }
     }
 
@@ -65,27 +68,42 @@ impl Layout {
         self
     }
 
-    /// Names of the states, for reports (`dr_x`, ..., `psi_z`, `bg_x`, ...).
+    /// Add an odometer scale-factor state.
+    pub fn with_odometer_scale(mut self) -> Self {
+        self.odometer_scale = Some(self.n);
+        self.n += 1;
+        self
+    }
+
+    /// Names of the states, for reports (`dr_x`, ..., `psi_z`, `bg_x`, ...), each at
+    /// its block's offset.
     pub fn names(&self) -> Vec<String> {
-        let mut names = Vec::with_capacity(self.n);
-        let mut block = |prefix: &str| {
-            for axis in ["x", "y", "z"] {
-                names.push(format!("{prefix}_{axis}"));
+        let mut names = vec![String::new(); self.n];
+        let mut block = |at: Option<usize>, prefix: &str| {
+            if let Some(o) = at {
+                for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+                    names[o + i] = format!("{prefix}_{axis}");
+                }
             }
         };
-        for p in ["dr", "dv", "psi", "bg", "ba"] {
-            block(p);
+        for (o, p) in [
+            (Self::POS, "dr"),
+            (Self::VEL, "dv"),
+            (Self::ATT, "psi"),
+            (Self::GYRO_BIAS, "bg"),
+            (Self::ACCEL_BIAS, "ba"),
+        ] {
+            block(Some(o), p);
         }
-        if self.gyro_scale.is_some() {
-            block("sg");
-            block("sa");
-        }
-        if self.baro_bias.is_some() {
-            names.push("baro_bias".into());
-        }
-        if self.attitude_ref.is_some() {
-            for axis in ["x", "y", "z"] {
-                names.push(format!("psi_ref_{axis}"));
+        block(self.gyro_scale, "sg");
+        block(self.accel_scale, "sa");
+        block(self.attitude_ref, "psi_ref");
+        for (at, name) in [
+            (self.baro_bias, "baro_bias"),
+            (self.odometer_scale, "odometer_scale"),
+        ] {
+            if let Some(o) = at {
+                names[o] = name.into();
             }
         }
         names
@@ -101,13 +119,22 @@ mod tests {
         let l = Layout::core()
             .with_scale_factors()
             .with_baro_bias()
-            .with_attitude_ref();
-        assert_eq!(l.n, 25);
+            .with_attitude_ref()
+            .with_odometer_scale();
+        assert_eq!(l.n, 26);
         assert_eq!(l.gyro_scale, Some(15));
         assert_eq!(l.accel_scale, Some(18));
         assert_eq!(l.baro_bias, Some(21));
         assert_eq!(l.attitude_ref, Some(22));
-        assert_eq!(l.names().len(), l.n);
-        assert_eq!(l.names()[24], "psi_ref_z");
+        assert_eq!(l.odometer_scale, Some(25));
+        let names = l.names();
+        assert_eq!(names.len(), l.n);
+        assert!(names.iter().all(|n| !n.is_empty()));
+        assert_eq!(names[18], "sa_x");
+        assert_eq!(names[24], "psi_ref_z");
+        assert_eq!(names[25], "odometer_scale");
+        // Another order of the builders: the names follow the offsets.
+        let l = Layout::core().with_odometer_scale().with_baro_bias();
+        assert_eq!(l.names()[15..], ["odometer_scale", "baro_bias"]);
     }
 }

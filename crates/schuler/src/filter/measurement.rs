@@ -10,6 +10,9 @@
 //! - Barometric height `h_b = h + b + v` with a bias state: `c`'s third axis is down in
 //!   both mechanizations, so `z = ĥ − (h_b − b̂) = −δr_z − δb + v`.
 //! - Measurement noise given in NED is turned into `c`: `R_c = C_cn R_n C_nc`.
+//!
+//! The vehicle measurements (zero velocity and angular rate, non-holonomic constraint,
+//! odometer, dual-antenna heading) are in [`super::vehicle`].
 
 use super::layout::Layout;
 use crate::earth::{EarthModel, Geodetic, c_ne};
@@ -26,14 +29,26 @@ pub enum Kind {
     GnssVelocity,
     /// Barometric height.
     BaroHeight,
+    /// Zero velocity at rest (ZUPT).
+    ZeroVelocity,
+    /// Zero angular rate relative to the Earth at rest (ZARU).
+    ZeroRate,
+    /// Non-holonomic constraint: no lateral or vertical velocity of the vehicle.
+    NonHolonomic,
+    /// Odometer forward speed.
+    Odometer,
+    /// Dual-antenna GNSS baseline heading (and pitch).
+    Heading,
 }
 
 impl Kind {
-    /// Unit of the innovation's components, for reports: `m`, `m/s`.
+    /// Unit of the innovation's components, for reports: `m`, `m/s`, `rad/s`, `rad`.
     pub fn unit(self) -> &'static str {
         match self {
             Kind::GnssPosition | Kind::BaroHeight => "m",
-            Kind::GnssVelocity => "m/s",
+            Kind::GnssVelocity | Kind::ZeroVelocity | Kind::NonHolonomic | Kind::Odometer => "m/s",
+            Kind::ZeroRate => "rad/s",
+            Kind::Heading => "rad",
         }
     }
 }
@@ -44,6 +59,11 @@ impl std::fmt::Display for Kind {
             Kind::GnssPosition => "gnss_position",
             Kind::GnssVelocity => "gnss_velocity",
             Kind::BaroHeight => "baro_height",
+            Kind::ZeroVelocity => "zupt",
+            Kind::ZeroRate => "zaru",
+            Kind::NonHolonomic => "nhc",
+            Kind::Odometer => "odometer",
+            Kind::Heading => "heading",
         })
     }
 }
@@ -66,12 +86,12 @@ pub fn c_nc(frame: &FrameSnapshot, at: &Geodetic) -> Matrix3<f64> {
     frame.c_ce_to_e.transpose() * c_ne(at.lat, at.lon)
 }
 
-fn ned_covariance(c: &Matrix3<f64>, std: &Vector3<f64>) -> DMatrix<f64> {
+pub(crate) fn ned_covariance(c: &Matrix3<f64>, std: &Vector3<f64>) -> DMatrix<f64> {
     let r = c * Matrix3::from_diagonal(&std.component_mul(std)) * c.transpose();
     DMatrix::from_fn(3, 3, |i, j| r[(i, j)])
 }
 
-fn put(h: &mut DMatrix<f64>, c: usize, m: &Matrix3<f64>) {
+pub(crate) fn put(h: &mut DMatrix<f64>, c: usize, m: &Matrix3<f64>) {
     h.fixed_view_mut::<3, 3>(0, c).copy_from(m);
 }
 

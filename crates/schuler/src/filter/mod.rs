@@ -6,7 +6,9 @@
 //! - [`error_model`]: the psi-angle error dynamics `F`, their transition matrix and
 //!   discrete process noise (non-singular at the poles, see [`crate::nav::frame`]);
 //! - [`interval`]: the sums over one propagation interval;
-//! - [`measurement`]: GNSS position and velocity with lever arm;
+//! - [`measurement`]: GNSS position and velocity with lever arm, barometric height;
+//! - [`vehicle`]: zero velocity and angular rate at rest, the non-holonomic
+//!   constraint, odometer speed, dual-antenna heading;
 //! - [`integration`]: the loosely coupled INS/GNSS filter loop;
 //! - [`smoother`]: the Rauch–Tung–Striebel backward pass;
 //! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
@@ -20,9 +22,11 @@ pub mod layout;
 pub mod measurement;
 pub mod noise;
 pub mod smoother;
+pub mod vehicle;
 
 pub use error_model::{ErrorModel, IntervalMeans};
 pub use integration::{GnssFix, IntegrationConfig, Integrator, SensorEstimates};
 pub use kalman::{Gate, Kalman, Rejection, Update};
 pub use layout::Layout;
 pub use noise::ImuNoise;
+pub use vehicle::{Baseline, HeadingReading, VehicleMount};

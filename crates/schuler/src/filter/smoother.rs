@@ -178,6 +178,12 @@ impl SmootherLog {
                 if let Some(a) = layout.accel_scale {
                     est.accel_scale += v3(a);
                 }
+                if let Some(b) = layout.baro_bias {
+                    est.baro_bias += err[b];
+                }
+                if let Some(o) = layout.odometer_scale {
+                    est.odometer_scale += err[o];
+                }
                 Smoothed {
                     state: nav_state_from_ecef(earth, t, &r, &v, &q),
                     estimates: est,

@@ -11,3 +11,4 @@ pub mod run;
 pub mod scenario;
 pub mod sensor_spec;
 pub mod spline;
+pub mod vehicle;
