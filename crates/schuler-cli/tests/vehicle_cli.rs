@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 mod common;
 
-/// The simulated drive and its vehicle logs, made once: `sim/` holds `imu.txt`,
+/// The simulated drive and its vehicle logs, made once: `drive/` holds `imu.txt`,
 /// `gnss.txt`, `baro.csv`, `truth.nav`, `odometer.txt` (10 Hz, 0.3 % scale error,
 /// 0.05 m/s noise), `rest.txt` (the wait) and `heading.txt` (1 Hz, 0.1°, baseline 90°
 /// to the right).
@@ -23,7 +23,9 @@ fn drive() -> &'static Path {
     static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
     &DIR.get_or_init(|| {
         let dir = tempfile::tempdir().expect("tempdir");
-        let sim = common::simulate_drive(dir.path());
+        // Named as examples/drive_nav.toml expects its files.
+        let sim = dir.path().join("drive");
+        std::fs::rename(common::simulate_drive(dir.path()), &sim).expect("rename");
         let truth: Vec<NavState> = common::read_rows(&sim.join("truth.nav"))
             .iter()
             .map(|r| {
