@@ -22,10 +22,14 @@ use nalgebra::Vector3;
 use schuler::align::{AlignConfig, Alignment, align};
 use schuler::earth::Wgs84;
 use schuler::filter::ImuNoise;
+use schuler::nav::LocalLevel;
 use std::path::PathBuf;
 use std::time::Instant;
 
 pub use sortie::{POLAR_FLIGHT, Sortie};
+
+/// The sortie's mechanization: NED (70 N is far from the poles).
+type Ned = LocalLevel<Wgs84>;
 
 /// Arguments of `schuler demo`.
 #[derive(clap::Args, Debug)]
@@ -144,17 +148,17 @@ pub fn run(args: DemoArgs) -> Result<()> {
     ];
     let ((forward, smoothed), inertial, coarse_only, no_baro) = std::thread::scope(|scope| {
         let aided = scope.spawn(|| {
-            modes::aided(
+            modes::aided::<Ned>(
                 &rec,
                 &fine_start,
-                &alignments.fine,
+                &modes::Prior::from_alignment(&alignments.fine),
                 &aided_settings,
                 &bars[0],
             )
         });
-        let inertial = modes::inertial(&rec, &fine_start, Some(gains), &bars[1]);
-        let coarse_only = modes::inertial(&rec, &coarse_start, Some(gains), &bars[2]);
-        let no_baro = modes::inertial(&rec, &fine_start, None, &bars[3]);
+        let inertial = modes::inertial::<Ned>(&rec, &fine_start, Some(gains), &bars[1]);
+        let coarse_only = modes::inertial::<Ned>(&rec, &coarse_start, Some(gains), &bars[2]);
+        let no_baro = modes::inertial::<Ned>(&rec, &fine_start, None, &bars[3]);
         let aided = aided
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
