@@ -11,9 +11,12 @@
 //! report with the CSV and SVG files behind its plots.
 
 mod capture;
+mod crossing;
 mod errors;
 mod modes;
 mod page;
+mod page_polar;
+mod polar;
 mod sortie;
 
 use anyhow::{Context, Result};
@@ -26,6 +29,7 @@ use schuler::nav::LocalLevel;
 use std::path::PathBuf;
 use std::time::Instant;
 
+pub use crossing::Crossing;
 pub use sortie::{POLAR_FLIGHT, Sortie};
 
 /// The sortie's mechanization: NED (70 N is far from the poles).
@@ -64,7 +68,7 @@ pub struct Alignments {
     pub coarse_only: Alignment,
 }
 
-fn bar(multi: &MultiProgress, name: &str, len: u64) -> ProgressBar {
+pub(crate) fn bar(multi: &MultiProgress, name: &str, len: u64) -> ProgressBar {
     let b = multi.add(ProgressBar::new(len));
     b.set_style(
         ProgressStyle::with_template("{prefix:>28} [{bar:30}] {pos:>5}/{len} s  {elapsed}")
@@ -191,6 +195,13 @@ pub fn run(args: DemoArgs) -> Result<()> {
     })
     .collect();
 
+    let crossing = if args.quick {
+        crossing::Crossing::quick(&sortie)?
+    } else {
+        crossing::Crossing::full(&sortie)?
+    };
+    let polar = polar::run(crossing, &aided_settings, &multi)?;
+
     let timing = page::Timing {
         simulate: simulate_s,
         align: align_s,
@@ -201,6 +212,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         &rec,
         &alignments,
         &runs,
+        &polar,
         gains,
         timing,
         started,
