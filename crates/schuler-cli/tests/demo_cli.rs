@@ -36,6 +36,15 @@ fn rows(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The row whose first cell is `label`.
+fn row_of(table: &[Vec<String>], label: &str) -> Vec<String> {
+    table
+        .iter()
+        .find(|r| r[0] == label)
+        .unwrap_or_else(|| panic!("no {label} row"))
+        .clone()
+}
+
 fn num(s: &str) -> f64 {
     s.parse().unwrap_or_else(|_| panic!("not a number: {s:?}"))
 }
@@ -121,13 +130,7 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     let sortie = Sortie::quick().expect("quick sortie");
     let summary = rows(&out.join("summary.csv"));
     assert_eq!(summary.len(), 5);
-    let by_mode = |label: &str| {
-        summary
-            .iter()
-            .find(|r| r[0] == label)
-            .unwrap_or_else(|| panic!("no {label} row"))
-            .clone()
-    };
+    let by_mode = |label: &str| row_of(&summary, label);
     // Column 4: max dS in flight. GNSS aiding beats free inertial navigation, and the
     // smoother does no worse than the forward filter.
     let free = num(&by_mode("inertial with baro loop")[4]);
@@ -210,13 +213,7 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     // 1 arcmin level uncertainty theta (the filter only improves on it) and an
     // unestimated 50 ug navigation-grade accelerometer bias b: 6.0 m; 25.1 m in all,
     // held for 5 s after the outage while the first fixes pull the drift back.
-    let by_label = |label: &str| {
-        polar
-            .iter()
-            .find(|r| r[0] == label)
-            .unwrap_or_else(|| panic!("no {label} row"))
-            .clone()
-    };
+    let by_label = |label: &str| row_of(&polar, label);
     let free = num(&by_label("wander inertial with baro loop")[5]);
     let aided = by_label("wander inertial-satellite forward");
     let smoothed = num(&by_label("wander inertial-satellite smoothed")[5]);

@@ -13,6 +13,7 @@ use schuler::sim::analytic::{self, Kinematics, Trajectory};
 use schuler::sim::imu_model::{ImuModel, ImuSimulator};
 use schuler::sim::receivers::{self, BaroReading, BaroSimulator, GnssSimulator};
 use schuler::sim::run::{ScenarioSpec, SimSink, simulate};
+use schuler::sim::sensor_spec::{BaroSpec, GnssSpec};
 
 /// One second's truth: the state and the IMU's biases then.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -192,26 +193,23 @@ pub fn record_trajectory<T: Trajectory>(
     let earth = Wgs84;
     let rate = spec.imu.rate_hz;
     let model = spec.imu.model().context("the IMU")?;
-    let mut gnss = spec
-        .gnss
-        .as_ref()
-        .map(|g| Ok::<_, anyhow::Error>(GnssSimulator::new(g.model()?, spec.seed)))
-        .transpose()
-        .context("the GNSS receiver")?;
-    let mut baro = spec
-        .baro
-        .as_ref()
-        .map(|b| Ok::<_, anyhow::Error>(BaroSimulator::new(b.model()?, spec.seed)))
-        .transpose()
-        .context("the barometer")?;
-    let gnss_every = gnss
-        .as_ref()
-        .map(|g| samples_per(g.interval(), rate, "GNSS"))
-        .transpose()?;
-    let baro_every = baro
-        .as_ref()
-        .map(|b| samples_per(b.interval(), rate, "barometer"))
-        .transpose()?;
+    let gnss = spec.gnss.as_ref().map(GnssSpec::model).transpose();
+    let baro = spec.baro.as_ref().map(BaroSpec::model).transpose();
+    // Each receiver with the number of IMU samples between its epochs.
+    let mut gnss = match gnss.context("the GNSS receiver")? {
+        Some(m) => Some((
+            samples_per(m.interval, rate, "GNSS")?,
+            GnssSimulator::new(m, spec.seed),
+        )),
+        None => None,
+    };
+    let mut baro = match baro.context("the barometer")? {
+        Some(m) => Some((
+            samples_per(m.interval, rate, "barometer")?,
+            BaroSimulator::new(m, spec.seed),
+        )),
+        None => None,
+    };
     let n = (duration * rate).round() as usize;
     let mut capture = Capture::new(model, spec.seed, rate, n + 1, bar);
     let dt = 1.0 / rate;
@@ -221,10 +219,7 @@ pub fn record_trajectory<T: Trajectory>(
         let (exact, truth, end) = analytic::increment_from(&earth, traj, t, dt, &kin);
         kin = end;
         capture.push(&exact, &truth);
-        if let Some(g) = gnss
-            .as_mut()
-            .filter(|_| gnss_every.is_some_and(|e| k % e == 0))
-        {
+        if let Some((_, g)) = gnss.as_mut().filter(|(every, _)| k % *every == 0) {
             let c_bn = truth.q_bn.to_rotation_matrix().into_inner();
             let w_ie_n = earth.local(truth.pos.lat, truth.pos.h).w_ie_n();
             let w_eb_b = kin.w_ib_b - c_bn.transpose() * w_ie_n;
@@ -235,9 +230,7 @@ pub fn record_trajectory<T: Trajectory>(
                 capture.gnss(&fix)?;
             }
         }
-        if let Some(b) = baro
-            .as_mut()
-            .filter(|_| baro_every.is_some_and(|e| k % e == 0))
+        if let Some((_, b)) = baro.as_mut().filter(|(every, _)| k % *every == 0)
             && let Some(r) = b.reading(t, t0, truth.pos.h)
         {
             capture.baro(&r)?;

@@ -59,6 +59,23 @@ pub struct ModeRun {
     pub errors: Vec<schuler::analysis::errors::EpochErrors>,
 }
 
+impl ModeRun {
+    /// The run `track` under `key` and `label`, with the errors `errors` finds in it.
+    pub fn new(
+        key: &'static str,
+        label: &'static str,
+        track: modes::Track,
+        errors: impl Fn(&modes::Track) -> Vec<schuler::analysis::errors::EpochErrors>,
+    ) -> Self {
+        Self {
+            key,
+            label,
+            errors: errors(&track),
+            track,
+        }
+    }
+}
+
 /// Both alignments: coarse and fine from the start, and coarse alone over the last
 /// coarse-stage length before navigation (so both end at the same instant).
 pub struct Alignments {
@@ -187,12 +204,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         ("smoothed", "inertial-satellite smoothed", smoothed),
     ]
     .into_iter()
-    .map(|(key, label, track)| ModeRun {
-        key,
-        label,
-        errors: errors::errors(&track, &rec),
-        track,
-    })
+    .map(|(key, label, track)| ModeRun::new(key, label, track, |t| errors::errors(t, &rec)))
     .collect();
 
     let crossing = if args.quick {

@@ -56,6 +56,25 @@ pub(super) fn csv(
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// A table of `rows` under `header`, also written as `name` in `dir` (the same
+/// strings in both).
+pub(super) fn table_with_csv(
+    dir: &Path,
+    name: &str,
+    header: &[&str],
+    rows: &[Vec<String>],
+) -> Result<Table> {
+    csv(
+        dir,
+        name,
+        &header.join(","),
+        rows.iter().map(|r| r.join(",")),
+    )?;
+    Ok(rows
+        .iter()
+        .fold(Table::new(header.iter().copied()), |t, r| t.row(r.clone())))
+}
+
 /// `plot` as `name` in `dir`.
 pub(super) fn svg(dir: &Path, name: &str, plot: &Plot) -> Result<()> {
     plot.write(&dir.join(name))
@@ -548,16 +567,7 @@ pub fn write(
 
     // Summary.
     let rows: Vec<Vec<String>> = runs.iter().map(|r| summary_row(r, s, end)).collect();
-    csv(
-        dir,
-        "summary.csv",
-        &SUMMARY_HEADER.join(","),
-        rows.iter().map(|r| r.join(",")),
-    )?;
-    let mut table = Table::new(SUMMARY_HEADER);
-    for r in &rows {
-        table = table.row(r.clone());
-    }
+    let table = table_with_csv(dir, "summary.csv", &SUMMARY_HEADER, &rows)?;
     let total = started.elapsed().as_secs_f64();
     let sec = report.section("summary", "Summary");
     sec.table(table.caption("Errors at the end of each phase (summary.csv)"));

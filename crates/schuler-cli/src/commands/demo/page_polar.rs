@@ -5,11 +5,11 @@
 
 use super::errors::{self, height};
 use super::modes::Track;
-use super::page::{csv, find, m, plot_circular, svg, write_mode};
+use super::page::{csv, find, m, plot_circular, svg, table_with_csv, write_mode};
 use super::polar::Polar;
 use super::{ModeRun, crossing::Crossing};
 use crate::plot::{LineStyle, Plot};
-use crate::report::{Report, Table};
+use crate::report::Report;
 use anyhow::Result;
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Wgs84};
@@ -337,16 +337,7 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
     sec.plot_with_files(&az, &["polar_azimuth.svg", "polar_azimuth.csv"]);
 
     let rows: Vec<Vec<String>> = p.runs.iter().map(|r| summary_row(r, c)).collect();
-    csv(
-        dir,
-        "polar_summary.csv",
-        &POLAR_SUMMARY_HEADER.join(","),
-        rows.iter().map(|r| r.join(",")),
-    )?;
-    let mut table = Table::new(POLAR_SUMMARY_HEADER);
-    for r in &rows {
-        table = table.row(r.clone());
-    }
+    let table = table_with_csv(dir, "polar_summary.csv", &POLAR_SUMMARY_HEADER, &rows)?;
     sec.table(table.caption("Errors across the pole (polar_summary.csv)"));
     sec.paragraph(&format!(
         "Simulation of the crossing {:.2} s; the modes ran in parallel.",

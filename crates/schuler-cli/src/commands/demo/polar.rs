@@ -81,11 +81,8 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
         ("polar_ned", "NED inertial with baro loop", ned),
     ]
     .into_iter()
-    .map(|(key, label, track)| ModeRun {
-        key,
-        label,
-        errors: errors::errors_near_pole(&track, &rec),
-        track,
+    .map(|(key, label, track)| {
+        ModeRun::new(key, label, track, |t| errors::errors_near_pole(t, &rec))
     })
     .collect();
     Ok(Polar {
