@@ -7,8 +7,11 @@
 //! navigation in the inertial mode (free, with and without the baro loop on the
 //! vertical channel; also after coarse alignment alone, the seed's comparison) and in
 //! the inertial-satellite mode (Kalman filter on GNSS position and velocity and the
-//! barometer, forward and smoothed). Everything goes into one self-contained HTML
-//! report with the CSV and SVG files behind its plots.
+//! barometer, forward and smoothed). Then a short second flight crosses the North
+//! Pole (`crossing.rs`, `polar.rs`), navigated with the all-latitude wander-azimuth
+//! mechanization in both modes and with NED in the inertial mode for contrast.
+//! Everything goes into one self-contained HTML report with the CSV and SVG files
+//! behind its plots.
 
 mod capture;
 mod crossing;
@@ -41,8 +44,8 @@ pub struct DemoArgs {
     /// Output directory.
     #[arg(long, default_value = "schuler-demo")]
     pub out: PathBuf,
-    /// A shortened sortie (200 Hz, 5 min on the pad, 7 min of flight) that runs in
-    /// seconds.
+    /// A shortened sortie (200 Hz, 5 min on the pad, 7 min of flight) and pole
+    /// crossing (4 min) that run in seconds.
     #[arg(long)]
     pub quick: bool,
 }

@@ -241,8 +241,9 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
          the inertial mode with the baro loop and in the inertial-satellite mode, the \
          filter's errors resolved in the wander frame. Errors are differences in ECEF \
          resolved along the truth's north and east: the latitude and longitude differences \
-         schuler compare uses (R dlat, R cos(lat) dlon) fail here, because near the pole a \
-         metre of error spans degrees of longitude (two points 30 m from the pole on \
+         schuler compare uses (R dlat, R cos(lat) dlon) fail here, because within tens of \
+         metres of the pole a metre of error spans degrees of longitude (two points 30 m \
+         from the pole on \
          opposite meridians are 60 m apart, not 94 m), and each state's velocity and heading \
          are in its own north.",
     );
@@ -279,7 +280,7 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
     let closest = closest_approach(&ned.track);
     let ground_speed = c.speed.hypot(across);
     sec.paragraph(&format!(
-        "The NED mechanization on the same samples (inertial mode): its own track passes {} m \
+        "The NED mechanization on the same samples (inertial mode): its own track passes {:.1} m \
          from the pole (between its 1-s epochs; its navigation error keeps it off the exact \
          point), its latitude {} 90 deg (largest {:.6} deg), and its longitude swings through \
          half a turn at up to v_E / ((R_N + h) cos lat), about V / d = {:.1} rad/s, which its \
@@ -289,8 +290,8 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
          transport rates), and the closer its own track passes, and the lower the sample \
          rate, the more it loses (schuler's wander_polar tests: 200 m within 30 s of a pass \
          6.4 m from the pole at 250 m/s and 200 Hz). The wander frame has no such rate: its \
-         azimuth takes the half turn instead, at the same bounded cost everywhere.",
-        m(closest),
+         azimuth takes the half turn instead.",
+        closest,
         if max_lat > std::f64::consts::FRAC_PI_2 {
             "runs beyond"
         } else {
