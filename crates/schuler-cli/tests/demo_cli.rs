@@ -1,10 +1,11 @@
 //! `schuler demo --quick`: the report exists and names every section, every plot has
 //! axes with units, the inertial-satellite errors are below the free-inertial ones,
-//! the summary table's numbers are the ones in the CSVs, and the same run gives the
-//! same data bit for bit.
+//! the summary tables' numbers are the ones in the CSVs, the flight across the pole
+//! passes over it with its aided error bounded, and the same run gives the same data
+//! bit for bit.
 
 use assert_cmd::Command;
-use schuler_cli::commands::demo::Sortie;
+use schuler_cli::commands::demo::{Crossing, Sortie};
 use std::path::Path;
 
 fn run_demo(out: &Path) -> String {
@@ -35,19 +36,63 @@ fn rows(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The row whose first cell is `label`.
+fn row_of(table: &[Vec<String>], label: &str) -> Vec<String> {
+    table
+        .iter()
+        .find(|r| r[0] == label)
+        .unwrap_or_else(|| panic!("no {label} row"))
+        .clone()
+}
+
 fn num(s: &str) -> f64 {
     s.parse().unwrap_or_else(|_| panic!("not a number: {s:?}"))
 }
 
-const SECTIONS: [&str; 7] = [
+const SECTIONS: [&str; 8] = [
     "sortie",
     "alignment",
     "inertial",
     "aided",
     "sensors",
     "vertical",
+    "polar",
     "summary",
 ];
+
+/// `cells` appear in the report's HTML after `from`, in order, each as a table cell.
+fn in_table_in_order(html: &str, from: &str, cells: &[String]) {
+    let mut rest = &html[html.find(from).unwrap_or_else(|| panic!("no {from}"))..];
+    for cell in cells {
+        let i = rest
+            .find(&format!(">{cell}</td>"))
+            .unwrap_or_else(|| panic!("{cell} of {} not in the report's table", cells[0]));
+        rest = &rest[i..];
+    }
+}
+
+/// The `errors_*.csv` row at time `t` (column 0), and the largest `|value|` of column
+/// `col` over the rows at or after `from`.
+struct ErrorsCsv(Vec<Vec<String>>);
+
+impl ErrorsCsv {
+    fn at(&self, t: f64) -> &[String] {
+        self.0
+            .iter()
+            .find(|e| num(&e[0]) == t)
+            .unwrap_or_else(|| panic!("no epoch {t}"))
+    }
+
+    fn max_from(&self, from: f64, col: usize) -> String {
+        let max = self
+            .0
+            .iter()
+            .filter(|e| num(&e[0]) >= from)
+            .map(|e| num(&e[col]).abs())
+            .fold(0.0, f64::max);
+        format!("{max:.3}")
+    }
+}
 
 #[test]
 fn quick_demo_report_is_complete_and_agrees_with_its_data() {
@@ -85,13 +130,7 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     let sortie = Sortie::quick().expect("quick sortie");
     let summary = rows(&out.join("summary.csv"));
     assert_eq!(summary.len(), 5);
-    let by_mode = |label: &str| {
-        summary
-            .iter()
-            .find(|r| r[0] == label)
-            .unwrap_or_else(|| panic!("no {label} row"))
-            .clone()
-    };
+    let by_mode = |label: &str| row_of(&summary, label);
     // Column 4: max dS in flight. GNSS aiding beats free inertial navigation, and the
     // smoother does no worse than the forward filter.
     let free = num(&by_mode("inertial with baro loop")[4]);
@@ -104,38 +143,94 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     );
     assert!(smoothed <= forward, "{smoothed} vs {forward}");
 
-    let summary_html = &html[html.find("<section id=\"summary\">").expect("summary")..];
     for row in &summary {
-        let errors = rows(&out.join(&row[8]));
-        let at = |t: f64| {
-            errors
-                .iter()
-                .find(|e| num(&e[0]) == t)
-                .unwrap_or_else(|| panic!("no epoch {t} in {}", row[8]))
-        };
-        let last = errors.last().expect("rows");
-        let flight = errors.iter().filter(|e| num(&e[0]) >= sortie.takeoff);
-        let max = |col: usize| {
-            flight
-                .clone()
-                .map(|e| num(&e[col]).abs())
-                .fold(0.0, f64::max)
-        };
+        let errors = ErrorsCsv(rows(&out.join(&row[8])));
+        let last = errors.0.last().expect("rows");
         // Columns of errors_*.csv: t, north, east, circular, height, roll, pitch, yaw.
-        assert_eq!(row[1], at(sortie.takeoff)[3], "{} take-off", row[0]);
-        assert_eq!(row[2], at(sortie.outages[0].1)[3], "{} outage end", row[0]);
+        assert_eq!(row[1], errors.at(sortie.takeoff)[3], "{} take-off", row[0]);
+        assert_eq!(
+            row[2],
+            errors.at(sortie.outages[0].1)[3],
+            "{} outage end",
+            row[0]
+        );
         assert_eq!(row[3], last[3], "{} end", row[0]);
-        assert_eq!(row[4], format!("{:.3}", max(3)), "{} max dS", row[0]);
-        assert_eq!(row[5], format!("{:.3}", max(4)), "{} max dh", row[0]);
+        assert_eq!(
+            row[4],
+            errors.max_from(sortie.takeoff, 3),
+            "{} max dS",
+            row[0]
+        );
+        assert_eq!(
+            row[5],
+            errors.max_from(sortie.takeoff, 4),
+            "{} max dh",
+            row[0]
+        );
         assert_eq!(row[6], last[7], "{} yaw", row[0]);
         // The report's table shows the same strings, in order.
-        let mut rest = summary_html;
-        for cell in row {
-            let i = rest
-                .find(&format!(">{cell}</td>"))
-                .unwrap_or_else(|| panic!("{cell} of {} not in the report's table", row[0]));
-            rest = &rest[i..];
-        }
+        in_table_in_order(&html, "<section id=\"summary\">", row);
+    }
+
+    // Across the pole: the crossing's own table, equal to its CSVs and the report's.
+    let crossing = Crossing::quick(&sortie).expect("quick crossing");
+    let polar = rows(&out.join("polar_summary.csv"));
+    assert_eq!(polar.len(), 4);
+    for row in &polar {
+        let errors = ErrorsCsv(rows(&out.join(&row[8])));
+        let last = errors.0.last().expect("rows");
+        assert_eq!(
+            row[1],
+            errors.at(crossing.outage.0)[3],
+            "{} outage start",
+            row[0]
+        );
+        assert_eq!(row[2], errors.at(crossing.t_pole())[3], "{} pole", row[0]);
+        assert_eq!(
+            row[3],
+            errors.at(crossing.outage.1)[3],
+            "{} outage end",
+            row[0]
+        );
+        assert_eq!(row[4], last[3], "{} end", row[0]);
+        assert_eq!(row[5], errors.max_from(crossing.t0, 3), "{} max dS", row[0]);
+        assert_eq!(row[6], errors.max_from(crossing.t0, 4), "{} max dh", row[0]);
+        in_table_in_order(&html, "<section id=\"polar\">", row);
+    }
+    // The truth passes over the pole itself: its epoch at t_pole is on the axis (the
+    // track's x, y in km, 4 decimals: within 0.1 m).
+    let track = rows(&out.join("polar_track.csv"));
+    let over = track
+        .iter()
+        .find(|r| num(&r[0]) == crossing.t_pole())
+        .expect("epoch at the pole");
+    assert!(num(&over[1]).hypot(num(&over[2])) <= 1e-4, "{over:?}");
+    // GNSS aiding beats free inertial navigation across the pole, and stays bounded.
+    // Outside the outage a filter is at least as good as one fix: 3 sigma of a fix's
+    // horizontal error, 3 sqrt(1.5^2 + 1.5^2) = 6.4 m. At the outage's end it has
+    // drifted for 60 s from there: at most a fix's 3-sigma horizontal velocity error,
+    // 3 sqrt(2) 0.05 m/s x 60 s = 12.7 m, plus 1/2 (g theta + b) t^2 with the hand-over's
+    // 1 arcmin level uncertainty theta (the filter only improves on it) and an
+    // unestimated 50 ug navigation-grade accelerometer bias b: 6.0 m; 25.1 m in all,
+    // held for 5 s after the outage while the first fixes pull the drift back.
+    let by_label = |label: &str| row_of(&polar, label);
+    let free = num(&by_label("wander inertial with baro loop")[5]);
+    let aided = by_label("wander inertial-satellite forward");
+    let smoothed = num(&by_label("wander inertial-satellite smoothed")[5]);
+    assert!(num(&aided[5]) < free, "{aided:?} vs {free}");
+    assert!(smoothed <= num(&aided[5]), "{smoothed} vs {aided:?}");
+    let fix_3sigma = 3.0 * 1.5f64.hypot(1.5);
+    let drift = 3.0 * 2f64.sqrt() * 0.05 * 60.0
+        + 0.5 * (9.81 * (1.0f64 / 60.0).to_radians() + 50e-6 * 9.81) * 60.0 * 60.0;
+    let errors = ErrorsCsv(rows(&out.join(&aided[8])));
+    for e in &errors.0 {
+        let (t, ds) = (num(&e[0]), num(&e[3]));
+        let bound = if t > crossing.outage.0 && t <= crossing.outage.1 + 5.0 {
+            fix_3sigma + drift
+        } else {
+            fix_3sigma
+        };
+        assert!(ds < bound, "dS {ds} m at {t} s above {bound} m");
     }
 
     // Same seed, same data: a second run writes the same bytes (run times aside).
@@ -144,7 +239,12 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     for f in std::fs::read_dir(&out).expect("dir") {
         let name = f.expect("entry").file_name();
         let name = name.to_string_lossy();
-        if name.starts_with("errors_") || name.starts_with("nav_") || name == "sensors.csv" {
+        let data = name.starts_with("errors_")
+            || name.starts_with("nav_")
+            || name == "sensors.csv"
+            || name == "polar_track.csv"
+            || name == "polar_azimuth.csv";
+        if data {
             assert!(
                 read(&out.join(&*name)) == read(&again.join(&*name)),
                 "{name} differs between runs"

@@ -7,13 +7,19 @@
 //! navigation in the inertial mode (free, with and without the baro loop on the
 //! vertical channel; also after coarse alignment alone, the seed's comparison) and in
 //! the inertial-satellite mode (Kalman filter on GNSS position and velocity and the
-//! barometer, forward and smoothed). Everything goes into one self-contained HTML
-//! report with the CSV and SVG files behind its plots.
+//! barometer, forward and smoothed). Then a short second flight crosses the North
+//! Pole (`crossing.rs`, `polar.rs`), navigated with the all-latitude wander-azimuth
+//! mechanization in both modes and with NED in the inertial mode for contrast.
+//! Everything goes into one self-contained HTML report with the CSV and SVG files
+//! behind its plots.
 
 mod capture;
+mod crossing;
 mod errors;
 mod modes;
 mod page;
+mod page_polar;
+mod polar;
 mod sortie;
 
 use anyhow::{Context, Result};
@@ -22,10 +28,15 @@ use nalgebra::Vector3;
 use schuler::align::{AlignConfig, Alignment, align};
 use schuler::earth::Wgs84;
 use schuler::filter::ImuNoise;
+use schuler::nav::LocalLevel;
 use std::path::PathBuf;
 use std::time::Instant;
 
+pub use crossing::Crossing;
 pub use sortie::{POLAR_FLIGHT, Sortie};
+
+/// The sortie's mechanization: NED (70 N is far from the poles).
+type Ned = LocalLevel<Wgs84>;
 
 /// Arguments of `schuler demo`.
 #[derive(clap::Args, Debug)]
@@ -33,8 +44,8 @@ pub struct DemoArgs {
     /// Output directory.
     #[arg(long, default_value = "schuler-demo")]
     pub out: PathBuf,
-    /// A shortened sortie (200 Hz, 5 min on the pad, 7 min of flight) that runs in
-    /// seconds.
+    /// A shortened sortie (200 Hz, 5 min on the pad, 7 min of flight) and pole
+    /// crossing (4 min) that run in seconds.
     #[arg(long)]
     pub quick: bool,
 }
@@ -51,6 +62,23 @@ pub struct ModeRun {
     pub errors: Vec<schuler::analysis::errors::EpochErrors>,
 }
 
+impl ModeRun {
+    /// The run `track` under `key` and `label`, with the errors `errors` finds in it.
+    pub fn new(
+        key: &'static str,
+        label: &'static str,
+        track: modes::Track,
+        errors: impl Fn(&modes::Track) -> Vec<schuler::analysis::errors::EpochErrors>,
+    ) -> Self {
+        Self {
+            key,
+            label,
+            errors: errors(&track),
+            track,
+        }
+    }
+}
+
 /// Both alignments: coarse and fine from the start, and coarse alone over the last
 /// coarse-stage length before navigation (so both end at the same instant).
 pub struct Alignments {
@@ -60,7 +88,7 @@ pub struct Alignments {
     pub coarse_only: Alignment,
 }
 
-fn bar(multi: &MultiProgress, name: &str, len: u64) -> ProgressBar {
+pub(crate) fn bar(multi: &MultiProgress, name: &str, len: u64) -> ProgressBar {
     let b = multi.add(ProgressBar::new(len));
     b.set_style(
         ProgressStyle::with_template("{prefix:>28} [{bar:30}] {pos:>5}/{len} s  {elapsed}")
@@ -144,17 +172,17 @@ pub fn run(args: DemoArgs) -> Result<()> {
     ];
     let ((forward, smoothed), inertial, coarse_only, no_baro) = std::thread::scope(|scope| {
         let aided = scope.spawn(|| {
-            modes::aided(
+            modes::aided::<Ned>(
                 &rec,
                 &fine_start,
-                &alignments.fine,
+                &modes::Prior::from_alignment(&alignments.fine),
                 &aided_settings,
                 &bars[0],
             )
         });
-        let inertial = modes::inertial(&rec, &fine_start, Some(gains), &bars[1]);
-        let coarse_only = modes::inertial(&rec, &coarse_start, Some(gains), &bars[2]);
-        let no_baro = modes::inertial(&rec, &fine_start, None, &bars[3]);
+        let inertial = modes::inertial::<Ned>(&rec, &fine_start, Some(gains), &bars[1]);
+        let coarse_only = modes::inertial::<Ned>(&rec, &coarse_start, Some(gains), &bars[2]);
+        let no_baro = modes::inertial::<Ned>(&rec, &fine_start, None, &bars[3]);
         let aided = aided
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
@@ -179,13 +207,15 @@ pub fn run(args: DemoArgs) -> Result<()> {
         ("smoothed", "inertial-satellite smoothed", smoothed),
     ]
     .into_iter()
-    .map(|(key, label, track)| ModeRun {
-        key,
-        label,
-        errors: errors::errors(&track, &rec),
-        track,
-    })
+    .map(|(key, label, track)| ModeRun::new(key, label, track, |t| errors::errors(t, &rec)))
     .collect();
+
+    let crossing = if args.quick {
+        crossing::Crossing::quick(&sortie)?
+    } else {
+        crossing::Crossing::full(&sortie)?
+    };
+    let polar = polar::run(crossing, &aided_settings, &multi)?;
 
     let timing = page::Timing {
         simulate: simulate_s,
@@ -197,6 +227,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         &rec,
         &alignments,
         &runs,
+        &polar,
         gains,
         timing,
         started,

@@ -1,9 +1,12 @@
-//! The sortie navigated the seed's ways, each from the aligned state at the start of
-//! navigation: the inertial mode (free strapdown, its vertical channel with or without
-//! the baro loop) and the inertial-satellite mode (error-state Kalman filter on GNSS
-//! position and velocity and the barometer; forward, and smoothed).
+//! A recording navigated the seed's ways, each from a given start on a given
+//! mechanization (NED, or the all-latitude wander frame through
+//! [`AidedMechanization`]): the inertial mode (free strapdown, its vertical channel
+//! with or without the baro loop) and the inertial-satellite mode (error-state Kalman
+//! filter on GNSS position and velocity and the barometer; forward, and smoothed).
 
 use super::capture::Recording;
+use crate::commands::aided::AidedMechanization;
+use crate::commands::nav::MechanizationKind;
 use indicatif::ProgressBar;
 use nalgebra::{DMatrix, Vector3};
 use schuler::align::Alignment;
@@ -12,7 +15,7 @@ use schuler::channel::vertical::{DetectorCounts, Gains};
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::{IntegrationConfig, Integrator, SensorEstimates};
 use schuler::filter::{Gate, ImuNoise, Layout};
-use schuler::nav::{BaroLoop, LocalLevel, Mechanization, NavState};
+use schuler::nav::{BaroLoop, NavState};
 use std::time::Instant;
 
 /// One output epoch (once a second).
@@ -23,6 +26,21 @@ pub struct Epoch {
     /// Filter standard deviations of position, velocity (NED, m and m/s) and attitude
     /// (about north, east, down, rad), when a filter runs.
     pub std: Option<[Vector3<f64>; 3]>,
+    /// Wander azimuth [rad] (the navigation frame's x axis east of north), when the
+    /// wander mechanization runs.
+    pub wander_azimuth: Option<f64>,
+}
+
+impl Epoch {
+    /// The epoch a mechanization reports now, with the filter's `std` if any.
+    fn of<M: AidedMechanization<Wgs84>>(mech: &M, std: Option<[Vector3<f64>; 3]>) -> Self {
+        let e = mech.epoch(&Wgs84);
+        Self {
+            state: e.state,
+            std,
+            wander_azimuth: (M::KIND == MechanizationKind::Wander).then_some(e.wander_azimuth),
+        }
+    }
 }
 
 /// The filter's sensor-error estimates at one epoch with their standard deviations.
@@ -102,21 +120,23 @@ fn first_after(baro: &[(f64, f64)], t: f64) -> usize {
     baro.partition_point(|(tb, _)| *tb <= t + 1e-9)
 }
 
-/// The inertial mode: free strapdown from `start`, the vertical channel damped by the
-/// baro loop when `gains` are given.
-pub fn inertial(rec: &Recording, start: &Start, gains: Option<Gains>, bar: &ProgressBar) -> Track {
+/// The inertial mode on the mechanization `M`: free strapdown from `start`, the
+/// vertical channel damped by the baro loop when `gains` are given.
+pub fn inertial<M: AidedMechanization<Wgs84>>(
+    rec: &Recording,
+    start: &Start,
+    gains: Option<Gains>,
+    bar: &ProgressBar,
+) -> Track {
     let clock = Instant::now();
     let i0 = rec.sample_at(start.state.t);
     let per_second = rec.per_second();
-    let mut mech = LocalLevel::new(Wgs84, start.state);
+    let mut mech = M::start(Wgs84, start.state);
     mech.prime(&start.estimates.compensate(&rec.imu[i0]));
     let mut baro_loop = gains.map(|g| BaroLoop::new(g, DetectorConfig::default()));
     let mut next_baro = first_after(&rec.baro, start.state.t);
     let mut track = Track::default();
-    track.epochs.push(Epoch {
-        state: mech.state(),
-        std: None,
-    });
+    track.epochs.push(Epoch::of(&mech, None));
     for (k, raw) in rec.imu[i0 + 1..].iter().enumerate() {
         mech.step(&start.estimates.compensate(raw));
         if let Some(l) = baro_loop.as_mut() {
@@ -125,10 +145,7 @@ pub fn inertial(rec: &Recording, start: &Start, gains: Option<Gains>, bar: &Prog
             }
         }
         if (k + 1) % per_second == 0 {
-            track.epochs.push(Epoch {
-                state: mech.state(),
-                std: None,
-            });
+            track.epochs.push(Epoch::of(&mech, None));
             bar.inc(1);
         }
     }
@@ -152,13 +169,40 @@ fn std3(p: &DMatrix<f64>, o: usize) -> Vector3<f64> {
     Vector3::from_fn(|i, _| p[(o + i, o + i)].max(0.0).sqrt())
 }
 
-/// The inertial-satellite mode: the 15-state error-state filter (plus the barometer
-/// bias) from `start` with alignment's uncertainties as its prior; returns the forward
-/// track and the Rauch–Tung–Striebel smoothed one.
-pub fn aided(
+/// The filter's initial uncertainty about the start.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prior {
+    /// Position standard deviations (NED) [m].
+    pub pos_std: Vector3<f64>,
+    /// Velocity standard deviations (NED) [m/s].
+    pub vel_std: Vector3<f64>,
+    /// Attitude standard deviations (about north, east, down) [rad].
+    pub att_std: Vector3<f64>,
+    /// Gyro and accelerometer bias standard deviations [rad/s, m/s^2], when they
+    /// differ from the IMU model's.
+    pub bias_std: Option<[Vector3<f64>; 2]>,
+}
+
+impl Prior {
+    /// After an alignment on the pad: the position held to the pad's survey (0.5 m),
+    /// the velocity at zero (0.01 m/s), attitude and biases as alignment found them.
+    pub fn from_alignment(a: &Alignment) -> Self {
+        Self {
+            pos_std: Vector3::repeat(0.5),
+            vel_std: Vector3::repeat(0.01),
+            att_std: a.attitude_std,
+            bias_std: Some([a.gyro_bias_std, a.accel_bias_std]),
+        }
+    }
+}
+
+/// The inertial-satellite mode on the mechanization `M`: the 15-state error-state
+/// filter (plus the barometer bias) from `start` with the uncertainties `prior`;
+/// returns the forward track and the Rauch–Tung–Striebel smoothed one.
+pub fn aided<M: AidedMechanization<Wgs84>>(
     rec: &Recording,
     start: &Start,
-    alignment: &Alignment,
+    prior: &Prior,
     settings: &AidedSettings,
     bar: &ProgressBar,
 ) -> (Track, Track) {
@@ -170,21 +214,17 @@ pub fn aided(
         gate: Gate::Level(1e-4),
         reset_after: 5,
         propagation_interval: 1.0,
-        // Alignment holds the position to the pad's survey and the velocity at zero.
-        init_pos_std: Vector3::repeat(0.5),
-        init_vel_std: Vector3::repeat(0.01),
-        init_att_std: alignment.attitude_std,
+        init_pos_std: prior.pos_std,
+        init_vel_std: prior.vel_std,
+        init_att_std: prior.att_std,
         baro: Some(settings.baro_bias),
-        init_sensor_std: Some([
-            alignment.gyro_bias_std,
-            alignment.accel_bias_std,
-            Vector3::zeros(),
-            Vector3::zeros(),
-        ]),
+        init_sensor_std: prior
+            .bias_std
+            .map(|[g, a]| [g, a, Vector3::zeros(), Vector3::zeros()]),
     };
     let i0 = rec.sample_at(start.state.t);
     let per_second = rec.per_second();
-    let mut integ = Integrator::new(LocalLevel::new(Wgs84, start.state), Wgs84, cfg)
+    let mut integ = Integrator::new(M::start(Wgs84, start.state), Wgs84, cfg)
         .with_estimates(start.estimates)
         .with_smoother();
     integ.prime(&rec.imu[i0]);
@@ -192,13 +232,12 @@ pub fn aided(
     let mut fixes = rec.gnss[first_fix..].iter().copied().peekable();
     let mut next_baro = first_after(&rec.baro, start.state.t);
     let mut forward = Track::default();
-    let record = |integ: &mut Integrator<LocalLevel<Wgs84>, Wgs84>, track: &mut Track| {
+    let record = |integ: &mut Integrator<M, Wgs84>, track: &mut Track| {
         integ.record_output();
         let p = integ.covariance();
-        track.epochs.push(Epoch {
-            state: integ.state(),
-            std: Some(integ.nav_std()),
-        });
+        track
+            .epochs
+            .push(Epoch::of(integ.mechanization(), Some(integ.nav_std())));
         track.sensors.push(SensorEpoch {
             t: integ.state().t,
             est: integ.estimates(),
@@ -227,6 +266,7 @@ pub fn aided(
             .map(|s| Epoch {
                 state: s.state,
                 std: Some(s.std),
+                wander_azimuth: None,
             })
             .collect(),
         sensors: Vec::new(),

@@ -5,7 +5,8 @@
 use super::capture::Recording;
 use super::errors::{self, height};
 use super::modes::{BARO_LOOP_TAU, Track};
-use super::{Alignments, ModeRun, Sortie};
+use super::polar::Polar;
+use super::{Alignments, ModeRun, Sortie, page_polar};
 use crate::plot::{LineStyle, Plot};
 use crate::report::{Report, Table};
 use anyhow::{Context, Result};
@@ -27,7 +28,7 @@ pub struct Timing {
 }
 
 /// Metres with millimetres (the CSVs' and the report's format).
-fn m(x: f64) -> String {
+pub(super) fn m(x: f64) -> String {
     format!("{x:.3}")
 }
 
@@ -36,7 +37,13 @@ fn arcmin(x: f64) -> String {
     format!("{:.2}", x.to_degrees() * 60.0)
 }
 
-fn csv(dir: &Path, name: &str, header: &str, rows: impl IntoIterator<Item = String>) -> Result<()> {
+/// `name` in `dir`: a header line, then one line per row.
+pub(super) fn csv(
+    dir: &Path,
+    name: &str,
+    header: &str,
+    rows: impl IntoIterator<Item = String>,
+) -> Result<()> {
     let path = dir.join(name);
     let file = std::fs::File::create(&path)
         .with_context(|| format!("cannot create {}", path.display()))?;
@@ -49,17 +56,37 @@ fn csv(dir: &Path, name: &str, header: &str, rows: impl IntoIterator<Item = Stri
         .with_context(|| format!("writing {}", path.display()))
 }
 
-fn svg(dir: &Path, name: &str, plot: &Plot) -> Result<()> {
+/// A table of `rows` under `header`, also written as `name` in `dir` (the same
+/// strings in both).
+pub(super) fn table_with_csv(
+    dir: &Path,
+    name: &str,
+    header: &[&str],
+    rows: &[Vec<String>],
+) -> Result<Table> {
+    csv(
+        dir,
+        name,
+        &header.join(","),
+        rows.iter().map(|r| r.join(",")),
+    )?;
+    Ok(rows
+        .iter()
+        .fold(Table::new(header.iter().copied()), |t, r| t.row(r.clone())))
+}
+
+/// `plot` as `name` in `dir`.
+pub(super) fn svg(dir: &Path, name: &str, plot: &Plot) -> Result<()> {
     plot.write(&dir.join(name))
 }
 
 /// Time axis of a series of errors [s].
-fn times(e: &[EpochErrors]) -> Vec<f64> {
+pub(super) fn times(e: &[EpochErrors]) -> Vec<f64> {
     e.iter().map(|x| x.t_sow).collect()
 }
 
 /// `errors_<key>.csv` and `nav_<key>.csv` of one mode.
-fn write_mode(dir: &Path, run: &ModeRun) -> Result<()> {
+pub(super) fn write_mode(dir: &Path, run: &ModeRun) -> Result<()> {
     csv(
         dir,
         &format!("errors_{}.csv", run.key),
@@ -144,17 +171,19 @@ const SUMMARY_HEADER: [&str; 9] = [
     "data",
 ];
 
-fn plot_circular(title: &str, runs: &[&ModeRun], s: &Sortie) -> Plot {
+/// Circular error dS of `runs` against time, the GNSS `outages` shaded.
+pub(super) fn plot_circular(title: &str, runs: &[&ModeRun], outages: &[(f64, f64)]) -> Plot {
     let mut p = Plot::new(title, "t [s]", "dS [m]");
     let styles = [LineStyle::Solid, LineStyle::Dashed, LineStyle::Dotted];
     for (r, style) in runs.iter().zip(styles.iter().cycle()) {
         let y: Vec<f64> = r.errors.iter().map(EpochErrors::horizontal).collect();
         p = p.line(r.label, &times(&r.errors), &y, *style);
     }
-    p.shade("GNSS outage", s.outages.iter().copied())
+    p.shade("GNSS outage", outages.iter().copied())
 }
 
-fn find<'a>(runs: &'a [ModeRun], key: &str) -> Result<&'a ModeRun> {
+/// The run `key`.
+pub(super) fn find<'a>(runs: &'a [ModeRun], key: &str) -> Result<&'a ModeRun> {
     runs.iter()
         .find(|r| r.key == key)
         .with_context(|| format!("no {key} run"))
@@ -341,6 +370,7 @@ pub fn write(
     rec: &Recording,
     a: &Alignments,
     runs: &[ModeRun],
+    polar: &Polar,
     gains: Gains,
     timing: Timing,
     started: Instant,
@@ -356,7 +386,8 @@ pub fn write(
          pad with the rotor turning, then {:.0} s of flight; IMU at {:.0} Hz (navigation \
          grade, rotor vibration at 17.5 and 35 Hz), GNSS at 1 Hz with an outage, a \
          barometer at 10 Hz. The truth is the simulator's exact trajectory. Scenario: \
-         examples/polar_flight.toml{}.",
+         examples/polar_flight.toml{}. Then a short second flight straight over the North \
+         Pole, navigated with the all-latitude wander-azimuth mechanization.",
         rec.truth[0].state.pos.lat.to_degrees(),
         s.takeoff,
         end - s.takeoff,
@@ -432,7 +463,11 @@ pub fn write(
     // Inertial mode.
     let inertial = find(runs, "inertial")?;
     let coarse = find(runs, "inertial_coarse")?;
-    let p = plot_circular("Inertial mode: circular error dS", &[coarse, inertial], s);
+    let p = plot_circular(
+        "Inertial mode: circular error dS",
+        &[coarse, inertial],
+        &s.outages,
+    );
     svg(dir, "inertial_circular.svg", &p)?;
     let ratio = errors::max_circular(&coarse.errors, s.nav_start(), end)
         / errors::max_circular(&inertial.errors, s.nav_start(), end);
@@ -470,7 +505,7 @@ pub fn write(
     let p = plot_circular(
         "Inertial-satellite mode: circular error dS",
         &[forward, smoothed],
-        s,
+        &s.outages,
     );
     svg(dir, "aided_circular.svg", &p)?;
     let sec = report.section("aided", "Inertial-satellite mode");
@@ -528,25 +563,19 @@ pub fn write(
             ],
         );
 
+    let polar_rows = page_polar::section(dir, &mut report, polar)?;
+
     // Summary.
     let rows: Vec<Vec<String>> = runs.iter().map(|r| summary_row(r, s, end)).collect();
-    csv(
-        dir,
-        "summary.csv",
-        &SUMMARY_HEADER.join(","),
-        rows.iter().map(|r| r.join(",")),
-    )?;
-    let mut table = Table::new(SUMMARY_HEADER);
-    for r in &rows {
-        table = table.row(r.clone());
-    }
+    let table = table_with_csv(dir, "summary.csv", &SUMMARY_HEADER, &rows)?;
     let total = started.elapsed().as_secs_f64();
     let sec = report.section("summary", "Summary");
     sec.table(table.caption("Errors at the end of each phase (summary.csv)"));
     sec.paragraph(&format!(
-        "Run time: simulation {:.2} s, alignment {:.2} s, navigation in parallel; {:.1} s in \
-         all before this report.",
-        timing.simulate, timing.align, total
+        "Run time: simulation {:.2} s, alignment {:.2} s, navigation in parallel, then the \
+         pole crossing (simulation {:.2} s, navigation in parallel); {:.1} s in all before \
+         this report. The crossing's errors are in its own table (section Across the pole).",
+        timing.simulate, timing.align, polar.simulate_s, total
     ));
     let missing = report.plots_missing_units();
     anyhow::ensure!(missing.is_empty(), "plots without units: {missing:?}");
@@ -565,6 +594,18 @@ pub fn write(
             out,
             "  {:<36} dS at end {:>10} m, max in flight {:>10} m",
             r[0], r[3], r[4]
+        );
+    }
+    let _ = writeln!(
+        out,
+        "across the pole ({:.0} s at {:.0} Hz):",
+        polar.crossing.duration, polar.rec.rate
+    );
+    for r in &polar_rows {
+        let _ = writeln!(
+            out,
+            "  {:<36} dS at end {:>10} m, max {:>10} m",
+            r[0], r[4], r[5]
         );
     }
     let _ = write!(out, "report: {}", path.display());
