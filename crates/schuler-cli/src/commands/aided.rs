@@ -132,9 +132,7 @@ impl Table {
     }
 }
 
-fn std3(p: &nalgebra::DMatrix<f64>, o: usize) -> Vector3<f64> {
-    Vector3::new(p[(o, o)], p[(o + 1, o + 1)], p[(o + 2, o + 2)]).map(|v| v.max(0.0).sqrt())
-}
+use schuler::filter::kalman::std3;
 
 /// A mechanization the aided navigation can run on.
 pub trait AidedMechanization<E: EarthModel>: ErrorFrame + Sized {
@@ -305,19 +303,7 @@ pub fn navigate_aided_on<M: AidedMechanization<E>, E: EarthModel, I>(
 where
     I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
 {
-    let first = match samples.next() {
-        Some(s) => s?,
-        None => bail!(
-            "{}: no IMU sample in the requested time window",
-            settings.imu.display()
-        ),
-    };
-    let init = NavState::new(
-        first.t,
-        settings.init_pos,
-        settings.init_vel,
-        settings.init_att,
-    );
+    let (first, init) = super::nav::first_sample(settings, &mut samples)?;
     let mut integ = aiding.vehicle.configure(
         Integrator::new(M::start(earth, init), earth, aiding.config)
             .with_estimates(aiding.initial_errors),

@@ -223,12 +223,8 @@ impl<'a> RunRecorder<'a> {
     pub fn sample<M: ErrorFrame, E: EarthModel>(&mut self, integ: &Integrator<M, E>) {
         let p = integ.covariance();
         let l = integ.layout();
-        let std3 = |o: Option<usize>| {
-            o.map_or(Vector3::zeros(), |o| {
-                Vector3::new(p[(o, o)], p[(o + 1, o + 1)], p[(o + 2, o + 2)])
-                    .map(|v| v.max(0.0).sqrt())
-            })
-        };
+        let std3 =
+            |o: Option<usize>| o.map_or(Vector3::zeros(), |o| schuler::filter::kalman::std3(p, o));
         let state = integ.state();
         let nees = if self.truth.is_empty() {
             None

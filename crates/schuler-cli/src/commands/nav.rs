@@ -728,15 +728,10 @@ where
     )
 }
 
-/// The sample loop: start `make(initial state)` at the first sample, prime it with
-/// that sample, step every later one, write decimated epochs.
-fn run_samples<R: Runner, I>(
-    make: impl FnOnce(NavState) -> R,
-    settings: &NavSettings,
-    mut samples: I,
-    mut writer: NavWriter,
-    mut on_sample: impl FnMut(u64),
-) -> Result<NavSummary>
+/// The first sample of the window and the initial state at its time (the settings'
+/// position, velocity and attitude), or an error naming the IMU file when the window
+/// holds no sample.
+pub fn first_sample<I>(settings: &NavSettings, samples: &mut I) -> Result<(ImuSample, NavState)>
 where
     I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
 {
@@ -753,6 +748,22 @@ where
         settings.init_vel,
         settings.init_att,
     );
+    Ok((first, init))
+}
+
+/// The sample loop: start `make(initial state)` at the first sample, prime it with
+/// that sample, step every later one, write decimated epochs.
+fn run_samples<R: Runner, I>(
+    make: impl FnOnce(NavState) -> R,
+    settings: &NavSettings,
+    mut samples: I,
+    mut writer: NavWriter,
+    mut on_sample: impl FnMut(u64),
+) -> Result<NavSummary>
+where
+    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+{
+    let (first, init) = first_sample(settings, &mut samples)?;
     let mut nav = make(init);
     let first_mechanization = nav.kind();
     nav.prime(&first);

@@ -359,9 +359,7 @@ pub fn align<E: EarthModel>(
     );
     let p = &fine.covariance;
     let p_psi = p.fixed_view::<3, 3>(Layout::ATT, Layout::ATT).into_owned();
-    let std = |o: usize| {
-        Vector3::new(p[(o, o)], p[(o + 1, o + 1)], p[(o + 2, o + 2)]).map(|v| v.max(0.0).sqrt())
-    };
+    let std = |o: usize| crate::filter::kalman::std3(p, o);
     let names = Layout::core().with_attitude_ref().names();
     out.observability = names
         .into_iter()

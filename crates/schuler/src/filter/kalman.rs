@@ -50,6 +50,12 @@ pub struct Kalman {
     pub p: DMatrix<f64>,
 }
 
+/// Standard deviations of the three states from `o` (square roots of the covariance's
+/// diagonal, negative round-off taken as zero).
+pub fn std3(p: &DMatrix<f64>, o: usize) -> nalgebra::Vector3<f64> {
+    nalgebra::Vector3::from_fn(|i, _| p[(o + i, o + i)].max(0.0).sqrt())
+}
+
 /// Make states `to..to+k` copies of `from..from+k` in a covariance (a state that
 /// equals another at this instant).
 pub fn duplicate_states(p: &mut DMatrix<f64>, from: usize, to: usize, k: usize) {

@@ -159,10 +159,7 @@ impl SmootherLog {
                     )
                 };
                 let v3 = |o: usize| Vector3::new(err[o], err[o + 1], err[o + 2]);
-                let std3 = |o: usize| {
-                    Vector3::new(p[(o, o)], p[(o + 1, o + 1)], p[(o + 2, o + 2)])
-                        .map(|x| x.max(0.0).sqrt())
-                };
+                let std3 = |o: usize| super::kalman::std3(p, o);
                 let errors = NavErrors {
                     dr: v3(Layout::POS),
                     dv: v3(Layout::VEL),

@@ -8,12 +8,13 @@ use super::capture::Recording;
 use crate::commands::aided::AidedMechanization;
 use crate::commands::nav::MechanizationKind;
 use indicatif::ProgressBar;
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::Vector3;
 use schuler::align::Alignment;
 use schuler::channel::detector::DetectorConfig;
 use schuler::channel::vertical::{DetectorCounts, Gains};
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::{IntegrationConfig, Integrator, SensorEstimates};
+use schuler::filter::kalman::std3;
 use schuler::filter::{Gate, ImuNoise, Layout};
 use schuler::nav::{BaroLoop, NavState};
 use std::time::Instant;
@@ -163,10 +164,6 @@ pub struct AidedSettings {
     pub baro_std: f64,
     /// Prior std of the barometer bias [m] and its random-walk density [m/sqrt(s)].
     pub baro_bias: (f64, f64),
-}
-
-fn std3(p: &DMatrix<f64>, o: usize) -> Vector3<f64> {
-    Vector3::from_fn(|i, _| p[(o + i, o + i)].max(0.0).sqrt())
 }
 
 /// The filter's initial uncertainty about the start.
