@@ -20,18 +20,16 @@
 //! - `baro.csv` (`t,h_m,outlier`);
 //! - `scenario.resolved.toml`: every parameter actually used, seed included.
 //!
-//! The IMU files and the truth files are formatted and written on two threads, block
-//! by block, while the simulator computes the next block. The same scenario and seed
-//! give the same bytes.
+//! Blocks of samples are formatted on the simulator's workers, each block while others
+//! are computed or written, and written in time order
+//! ([`schuler::sim::run::simulate_with`]). The same scenario and seed give the same
+//! bytes.
 
 use crate::fixed::push_fixed;
 use crate::output::{ImuDigits, push_imu_line, push_nav_fields};
 use anyhow::{Context, Result};
-use schuler::imu::ImuSample;
-use schuler::nav::NavState;
-use schuler::sim::analytic::Kinematics;
-use schuler::sim::receivers::{BaroReading, GnssFix};
-use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, SimSink, simulate};
+use schuler::sim::receivers::GnssFix;
+use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -81,46 +79,6 @@ impl Out {
     }
 }
 
-/// Appends numbers separated by `sep` in shortest round-trip form.
-struct Line {
-    buf: Vec<u8>,
-    num: zmij::Buffer,
-}
-
-impl Line {
-    fn new() -> Self {
-        Self {
-            buf: Vec::with_capacity(512),
-            num: zmij::Buffer::new(),
-        }
-    }
-
-    fn start(&mut self) -> &mut Self {
-        self.buf.clear();
-        self
-    }
-
-    fn num(&mut self, x: f64, sep: u8) -> &mut Self {
-        if !self.buf.is_empty() {
-            self.buf.push(sep);
-        }
-        self.buf.extend_from_slice(self.num.format(x).as_bytes());
-        self
-    }
-
-    fn nums(&mut self, xs: &[f64], sep: u8) -> &mut Self {
-        for &x in xs {
-            self.num(x, sep);
-        }
-        self
-    }
-
-    fn write(&mut self, out: &mut Out) -> std::io::Result<()> {
-        self.buf.push(b'\n');
-        out.write_all(&self.buf)
-    }
-}
-
 /// Decimals of the true angular rate in `truth.csv` (1e-12 rad/s).
 const W_DECIMALS: usize = 12;
 /// Decimals of the true specific force in `truth.csv` (1e-10 m/s^2).
@@ -128,19 +86,24 @@ const F_DECIMALS: usize = 10;
 
 /// `bytes` with every space turned into a comma, appended to `out`.
 fn push_as_csv(out: &mut Vec<u8>, bytes: &[u8]) {
-    out.extend(bytes.iter().map(|&b| if b == b' ' { b',' } else { b }));
+    let start = out.len();
+    out.extend_from_slice(bytes);
+    // An unconditional store per byte, so the loop runs on vector lanes.
+    for b in &mut out[start..] {
+        *b = if *b == b' ' { b',' } else { *b };
+    }
 }
 
 /// `imu.txt` and `imu.csv` lines of the measured samples of `epochs`. Each number is
 /// formatted once: the CSV line is the same bytes with commas for spaces (no number
 /// contains either).
 fn imu_lines(epochs: &[ImuEpoch], txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
+    let start = txt.len();
     for e in epochs {
-        let start = txt.len();
         push_imu_line(txt, &e.measured, b' ', ImuDigits::Shortest);
         txt.push(b'\n');
-        push_as_csv(csv, &txt[start..]);
     }
+    push_as_csv(csv, &txt[start..]);
 }
 
 /// `truth.nav` lines (week 0, then `t lat lon h vn ve vd roll pitch yaw`) and
@@ -167,103 +130,150 @@ fn truth_lines(epochs: &[ImuEpoch], nav: &mut Vec<u8>, csv: &mut Vec<u8>) {
     }
 }
 
-/// A per-epoch stream's two files (KF-GINS text and CSV twin) and their text for the
-/// current block (the memory reused from block to block).
-struct Pair {
-    txt: Out,
-    csv: Out,
-    txt_text: Vec<u8>,
-    csv_text: Vec<u8>,
+/// Append `xs` in shortest round-trip form separated by `sep`, then a newline.
+fn push_shortest_line(out: &mut Vec<u8>, xs: &[f64], sep: u8) {
+    let mut num = zmij::Buffer::new();
+    for (i, &x) in xs.iter().enumerate() {
+        if i > 0 {
+            out.push(sep);
+        }
+        out.extend_from_slice(num.format(x).as_bytes());
+    }
+    out.push(b'\n');
 }
 
-impl Pair {
-    fn create(dir: &Path, txt: &str, csv: &str, csv_header: &str) -> Result<Self> {
-        let mut p = Self {
-            txt: Out::create(dir, txt)?,
-            csv: Out::create(dir, csv)?,
-            txt_text: Vec::new(),
-            csv_text: Vec::new(),
-        };
-        writeln!(p.csv.w, "{csv_header}")
-            .with_context(|| format!("cannot write {}", p.csv.path.display()))?;
-        Ok(p)
-    }
+/// `gnss.txt` (`t lat lon h std_n std_e std_d`) and `gnss.csv` (the same, then the
+/// velocity, its std and the outlier flag) lines of a fix.
+fn gnss_lines(fix: &GnssFix, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
+    let (p, sd, v, vsd) = (fix.pos, fix.pos_std, fix.v_n, fix.vel_std);
+    let row = [
+        fix.t,
+        p.lat.to_degrees(),
+        p.lon.to_degrees(),
+        p.h,
+        sd.x,
+        sd.y,
+        sd.z,
+        v.x,
+        v.y,
+        v.z,
+        vsd.x,
+        vsd.y,
+        vsd.z,
+        f64::from(u8::from(fix.outlier)),
+    ];
+    push_shortest_line(txt, &row[..7], b' ');
+    push_shortest_line(csv, &row, b',');
+}
 
-    /// Format `epochs` with `lines` and write the text to both files; an error names
-    /// the file.
-    fn write(
-        &mut self,
-        epochs: &[ImuEpoch],
-        lines: fn(&[ImuEpoch], &mut Vec<u8>, &mut Vec<u8>),
-    ) -> std::io::Result<()> {
-        self.txt_text.clear();
-        self.csv_text.clear();
-        lines(epochs, &mut self.txt_text, &mut self.csv_text);
-        self.txt.write_all(&self.txt_text)?;
-        self.csv.write_all(&self.csv_text)
-    }
+/// The text of one block for every file (one per worker, its memory reused from block
+/// to block).
+#[derive(Default)]
+struct BlockText {
+    imu_txt: Vec<u8>,
+    imu_csv: Vec<u8>,
+    truth_nav: Vec<u8>,
+    truth_csv: Vec<u8>,
+    gnss_txt: Vec<u8>,
+    gnss_csv: Vec<u8>,
+    baro_csv: Vec<u8>,
+}
 
-    fn finish(self) -> Result<()> {
-        self.txt.finish()?;
-        self.csv.finish()
+impl BlockText {
+    /// The lines of `block` for every file.
+    fn format(&mut self, block: &SimBlock) {
+        for b in [
+            &mut self.imu_txt,
+            &mut self.imu_csv,
+            &mut self.truth_nav,
+            &mut self.truth_csv,
+            &mut self.gnss_txt,
+            &mut self.gnss_csv,
+            &mut self.baro_csv,
+        ] {
+            b.clear();
+        }
+        imu_lines(&block.imu, &mut self.imu_txt, &mut self.imu_csv);
+        truth_lines(&block.imu, &mut self.truth_nav, &mut self.truth_csv);
+        for (_, fix) in &block.gnss {
+            gnss_lines(fix, &mut self.gnss_txt, &mut self.gnss_csv);
+        }
+        for (_, r) in &block.baro {
+            let row = [r.t, r.h, f64::from(u8::from(r.outlier))];
+            push_shortest_line(&mut self.baro_csv, &row, b',');
+        }
     }
 }
 
-/// Writes every stream to its files.
-struct FileSink {
-    imu: Pair,
-    truth: Pair,
-    gnss_txt: Option<(Out, Out)>,
+/// Every output file.
+struct Files {
+    imu_txt: Out,
+    imu_csv: Out,
+    truth_nav: Out,
+    truth_csv: Out,
+    gnss: Option<(Out, Out)>,
     baro_csv: Option<Out>,
-    line: Line,
 }
 
-impl FileSink {
+impl Files {
     fn create(dir: &Path, gnss: bool, baro: bool) -> Result<Self> {
-        let mut s = Self {
-            imu: Pair::create(
-                dir,
-                "imu.txt",
+        let with_header = |name: &str, header: &str| -> Result<Out> {
+            let mut o = Out::create(dir, name)?;
+            writeln!(o.w, "{header}")
+                .with_context(|| format!("cannot write {}", o.path.display()))?;
+            Ok(o)
+        };
+        Ok(Self {
+            imu_txt: Out::create(dir, "imu.txt")?,
+            imu_csv: with_header(
                 "imu.csv",
                 "t,dtheta_x,dtheta_y,dtheta_z,dvel_x,dvel_y,dvel_z",
             )?,
-            truth: Pair::create(
-                dir,
-                "truth.nav",
+            truth_nav: Out::create(dir, "truth.nav")?,
+            truth_csv: with_header(
                 "truth.csv",
                 "t,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,w_x,w_y,w_z,f_x,f_y,f_z",
             )?,
-            gnss_txt: if gnss {
-                Some((Out::create(dir, "gnss.txt")?, Out::create(dir, "gnss.csv")?))
+            gnss: if gnss {
+                Some((
+                    Out::create(dir, "gnss.txt")?,
+                    with_header(
+                        "gnss.csv",
+                        "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier",
+                    )?,
+                ))
             } else {
                 None
             },
             baro_csv: if baro {
-                Some(Out::create(dir, "baro.csv")?)
+                Some(with_header("baro.csv", "t,h_m,outlier")?)
             } else {
                 None
             },
-            line: Line::new(),
-        };
-        let header = |o: &mut Out, h: &str| {
-            writeln!(o.w, "{h}").with_context(|| format!("cannot write {}", o.path.display()))
-        };
-        if let Some((_, csv)) = s.gnss_txt.as_mut() {
-            header(
-                csv,
-                "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier",
-            )?;
+        })
+    }
+
+    /// Write a block's text to every file; an error names the file.
+    fn write(&mut self, t: &BlockText) -> std::io::Result<()> {
+        self.imu_txt.write_all(&t.imu_txt)?;
+        self.imu_csv.write_all(&t.imu_csv)?;
+        self.truth_nav.write_all(&t.truth_nav)?;
+        self.truth_csv.write_all(&t.truth_csv)?;
+        if let Some((txt, csv)) = self.gnss.as_mut() {
+            txt.write_all(&t.gnss_txt)?;
+            csv.write_all(&t.gnss_csv)?;
         }
-        if let Some(b) = s.baro_csv.as_mut() {
-            header(b, "t,h_m,outlier")?;
+        if let Some(b) = self.baro_csv.as_mut() {
+            b.write_all(&t.baro_csv)?;
         }
-        Ok(s)
+        Ok(())
     }
 
     fn finish(self) -> Result<()> {
-        self.imu.finish()?;
-        self.truth.finish()?;
-        if let Some((a, b)) = self.gnss_txt {
+        for o in [self.imu_txt, self.imu_csv, self.truth_nav, self.truth_csv] {
+            o.finish()?;
+        }
+        if let Some((a, b)) = self.gnss {
             a.finish()?;
             b.finish()?;
         }
@@ -271,90 +281,6 @@ impl FileSink {
             b.finish()?;
         }
         Ok(())
-    }
-}
-
-impl SimSink for FileSink {
-    fn imu(
-        &mut self,
-        exact: &ImuSample,
-        measured: &ImuSample,
-        truth: &NavState,
-        kin: &Kinematics,
-    ) -> std::io::Result<()> {
-        let epoch = [ImuEpoch {
-            exact: *exact,
-            measured: *measured,
-            truth: *truth,
-            kin: *kin,
-        }];
-        self.imu.write(&epoch, imu_lines)?;
-        self.truth.write(&epoch, truth_lines)
-    }
-
-    /// The GNSS and barometer epochs (a few) as they come; the IMU files and the truth
-    /// files each formatted and written on a thread of their own: the same bytes as
-    /// one epoch at a time.
-    fn block(&mut self, block: &SimBlock) -> std::io::Result<()> {
-        for (_, fix) in &block.gnss {
-            self.gnss(fix)?;
-        }
-        for (_, r) in &block.baro {
-            self.baro(r)?;
-        }
-        let (imu, truth) = (&mut self.imu, &mut self.truth);
-        std::thread::scope(|scope| {
-            let job = scope.spawn(|| imu.write(&block.imu, imu_lines));
-            let truth_written = truth.write(&block.imu, truth_lines);
-            let imu_written = job.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-            imu_written.and(truth_written)
-        })
-    }
-
-    fn gnss(&mut self, fix: &GnssFix) -> std::io::Result<()> {
-        let Some((txt, csv)) = self.gnss_txt.as_mut() else {
-            return Ok(());
-        };
-        let pos = [
-            fix.pos.lat.to_degrees(),
-            fix.pos.lon.to_degrees(),
-            fix.pos.h,
-        ];
-        let sd = [fix.pos_std.x, fix.pos_std.y, fix.pos_std.z];
-        self.line
-            .start()
-            .num(fix.t, b' ')
-            .nums(&pos, b' ')
-            .nums(&sd, b' ')
-            .write(txt)?;
-        let v = [
-            fix.v_n.x,
-            fix.v_n.y,
-            fix.v_n.z,
-            fix.vel_std.x,
-            fix.vel_std.y,
-            fix.vel_std.z,
-        ];
-        self.line
-            .start()
-            .num(fix.t, b',')
-            .nums(&pos, b',')
-            .nums(&sd, b',')
-            .nums(&v, b',')
-            .num(f64::from(u8::from(fix.outlier)), b',')
-            .write(csv)
-    }
-
-    fn baro(&mut self, r: &BaroReading) -> std::io::Result<()> {
-        let Some(out) = self.baro_csv.as_mut() else {
-            return Ok(());
-        };
-        self.line
-            .start()
-            .num(r.t, b',')
-            .num(r.h, b',')
-            .num(f64::from(u8::from(r.outlier)), b',')
-            .write(out)
     }
 }
 
@@ -379,10 +305,14 @@ pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
 /// Simulate `spec` into `dir`; returns the summary.
 pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::run::SimSummary> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let mut sink = FileSink::create(dir, spec.gnss.is_some(), spec.baro.is_some())?;
-    let summary = simulate(spec, &mut sink);
+    let mut files = Files::create(dir, spec.gnss.is_some(), spec.baro.is_some())?;
+    let summary = simulate_with(
+        spec,
+        |block, text: &mut BlockText| text.format(block),
+        |text| files.write(text),
+    );
     // Flush what was written even when the simulation stopped early.
-    let flushed = sink.finish();
+    let flushed = files.finish();
     let summary = summary?;
     flushed?;
     let resolved =
