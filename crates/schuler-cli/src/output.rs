@@ -19,6 +19,7 @@ use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Geodetic};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
+use schuler::rotation::Euler;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -65,7 +66,11 @@ struct Row {
 impl Row {
     fn of(s: &NavState) -> Self {
         let s = &s.normalized();
-        let e = s.euler();
+        Self::with_euler(s, &s.euler())
+    }
+
+    /// The row of a state within latitude [-90°, 90°] whose attitude is `e`.
+    fn with_euler(s: &NavState, e: &Euler) -> Self {
         Self {
             lat_deg: s.pos.lat.to_degrees(),
             lon_deg: printable_lon(wrap_lon_deg(s.pos.lon), 11),
@@ -102,9 +107,17 @@ impl Row {
 /// Append the columns of a navigation row after its time, each preceded by `sep`:
 /// lat, lon [deg], h [m], vn, ve, vd [m/s], roll, pitch, yaw [deg], with the decimals
 /// of `nav.txt` (1e-11 deg, 1 um, 1 um/s, 1e-9 deg) and its ranges (latitude in
-/// [-90, 90], longitude in (-180, 180], yaw in [0, 360)).
-pub fn push_nav_fields(out: &mut Vec<u8>, s: &NavState, sep: u8) {
-    Row::of(s).push(out, sep);
+/// [-90, 90], longitude in (-180, 180], yaw in [0, 360)). The attitude comes as
+/// Euler angles (`s`'s own, e.g. a trajectory's, in [`Euler::from_dcm`]'s ranges),
+/// which spares three arctangents; a state past a pole is turned by
+/// [`NavState::normalized`], so its attitude then comes from `q_bn`.
+pub fn push_nav_fields(out: &mut Vec<u8>, s: &NavState, e: &Euler, sep: u8) {
+    let n = s.normalized();
+    if n == *s {
+        Row::with_euler(s, e).push(out, sep);
+    } else {
+        Row::with_euler(&n, &n.euler()).push(out, sep);
+    }
 }
 
 /// One navigation epoch with the quantities defined everywhere (poles included).

@@ -114,7 +114,7 @@ fn truth_lines(epochs: &[ImuEpoch], nav: &mut Vec<u8>, csv: &mut Vec<u8>) {
         nav.extend_from_slice(b"0 ");
         let start = nav.len();
         nav.extend_from_slice(num.format(e.truth.t).as_bytes());
-        push_nav_fields(nav, &e.truth, b' ');
+        push_nav_fields(nav, &e.truth, &e.euler, b' ');
         push_as_csv(csv, &nav[start..]);
         nav.push(b'\n');
         let (w, f) = (e.kin.w_ib_b, e.kin.f_b);

@@ -46,6 +46,11 @@ pub trait Trajectory {
     fn kinematics_at<E: EarthModel>(&self, earth: &E, t: f64) -> Kinematics {
         self.evaluate_at(earth, t).1
     }
+    /// The trajectory's own Z-Y-X Euler angles at `t` (any range), where it is written
+    /// in them: cheaper than taking them back out of the attitude. None by default.
+    fn euler_at(&self, _t: f64) -> Option<crate::rotation::Euler> {
+        None
+    }
     /// The times in `(a, b)`, increasing, where the motion is less smooth than
     /// elsewhere (a spline's knots, where the jerk may jump): [`increment_from`] splits
     /// its interval there. None by default (smooth everywhere).

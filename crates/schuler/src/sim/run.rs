@@ -130,6 +130,10 @@ pub struct ImuEpoch {
     pub truth: NavState,
     /// The true angular rate and specific force at `t`.
     pub kin: Kinematics,
+    /// The true attitude at `t` as Z-Y-X Euler angles in the ranges of
+    /// [`crate::rotation::Euler::from_dcm`] (from the trajectory's own angles where it
+    /// has them).
+    pub euler: crate::rotation::Euler,
 }
 
 /// Consecutive epochs of every stream: IMU epochs in time order, and the GNSS fixes and
@@ -499,14 +503,17 @@ fn exact_block<E: EarthModel, T: Trajectory>(
     let mut prev = analytic::kinematics(earth, traj, t0 + (k0 as f64 - 1.0) * dt);
     block.imu.clear();
     block.imu.extend((k0..k1).map(|k| {
-        let (exact, truth, kin) =
-            analytic::increment_from(earth, traj, t0 + k as f64 * dt, dt, &prev);
+        let t = t0 + k as f64 * dt;
+        let (exact, truth, kin) = analytic::increment_from(earth, traj, t, dt, &prev);
         prev = kin;
         ImuEpoch {
             exact,
             measured: exact,
             truth,
             kin,
+            euler: traj
+                .euler_at(t)
+                .map_or_else(|| truth.euler(), |e| e.principal()),
         }
     }));
 }
