@@ -9,11 +9,11 @@
 //! against one half, is the correctly rounded integer (ties to even, as std rounds the
 //! exact binary value).
 //!
-//! Digits: the 16 digits of the integer are made at once in byte lanes (SWAR), then
-//! placed with copies of constant size (the leading zeros skipped, the point put in),
-//! so a number costs a few dozen instructions and no call. Values beyond `10^16` after
-//! scaling take a digit loop; beyond `u64`, more than 19 decimals and NaN or infinity
-//! go through std's formatter.
+//! Digits: the 16 digits of the integer are made at once in byte lanes (SWAR), the
+//! leading zeros shifted out and the point shifted in, all in registers, and stored
+//! once, so a number costs a few dozen instructions, no call and no reload. Values of
+//! 10^15 and more after scaling take a digit loop; beyond `u64`, more than 19 decimals
+//! and NaN or infinity go through std's formatter.
 
 use std::io::Write;
 
@@ -39,10 +39,6 @@ const DIGIT_PAIRS: [u8; 200] = {
     }
     t
 };
-
-/// Room [`fixed_into`] needs: the longest text (sign, 21 digits, point: 23 bytes) or,
-/// on the fast path, a sign or digits and a point before a 16-byte copy.
-pub const FIXED_MAX_LEN: usize = 40;
 
 /// Largest scaled value whose floating-point fraction is exact (`< 2^52`).
 const FAST_LIMIT: f64 = 4.0e15;
@@ -140,66 +136,72 @@ fn put_digits(dst: &mut [u8], mut n: u64) -> u64 {
     n
 }
 
-/// Write `x` with exactly `decimals` digits after the point into the start of `dst`
-/// and return the length (bytes past it may be overwritten); `None` where std's
-/// formatter must do it (see the module doc). A value that rounds to zero is written
-/// without a sign.
+/// The text of `n / 10^decimals` with `decimals` digits after the point (no sign) as
+/// ASCII bytes in a `u128`, the first in the lowest byte, and its length; `None` past
+/// 15 digits (the text would not fit 16 bytes). All in registers: the leading zeros
+/// shifted out, the point shifted in, so that the caller stores it once and nothing is
+/// read back (a load of bytes just stored piecewise stalls the pipeline).
 #[inline]
-pub fn fixed_into(dst: &mut [u8; FIXED_MAX_LEN], x: f64, decimals: usize) -> Option<usize> {
-    let n = scaled(x, decimals)?;
-    let neg = usize::from(x.is_sign_negative() && n != 0);
-    dst[0] = b'-';
-    let point = usize::from(decimals > 0);
-    if n < POW10[16] && decimals < 16 {
-        // Digits 0..16, then zeros to read 16 bytes from any start up to 16.
-        let mut all = [b'0'; 32];
-        let ascii = ascii16(n);
-        all[..16].copy_from_slice(&ascii.to_le_bytes());
-        // Leading zero digits: the zero bytes of `ascii - '0'`, from the lowest.
-        let zeros =
-            ((ascii ^ 0x3030_3030_3030_3030_3030_3030_3030_3030).trailing_zeros() / 8) as usize;
-        // At least one digit before the point.
-        let digits = (16 - zeros).max(decimals + 1);
-        let int_len = digits - decimals;
-        dst[neg..neg + 16].copy_from_slice(&all[16 - digits..32 - digits]);
-        if point == 1 {
-            let at = neg + int_len;
-            dst[at] = b'.';
-            dst[at + 1..at + 17].copy_from_slice(&all[16 - decimals..32 - decimals]);
-        }
-        return Some(neg + digits + point);
+fn fixed_ascii(n: u64, decimals: usize) -> Option<(u128, usize)> {
+    if n >= POW10[15] || decimals >= 15 {
+        return None;
     }
+    let ascii = ascii16(n);
+    // Leading zero digits: the zero bytes of `ascii - '0'`, from the lowest (at least
+    // one, n < 10^15).
+    let zeros = ((ascii ^ 0x3030_3030_3030_3030_3030_3030_3030_3030).trailing_zeros() / 8) as usize;
+    // At least one digit before the point; at most 15 in all.
+    let digits = (16 - zeros).max(decimals + 1);
+    let all = ascii >> (8 * (16 - digits));
+    if decimals == 0 {
+        return Some((all, digits));
+    }
+    let int_len = digits - decimals;
+    let int_mask = (1u128 << (8 * int_len)) - 1;
+    let text = (all & int_mask) | (u128::from(b'.') << (8 * int_len)) | ((all & !int_mask) << 8);
+    Some((text, digits + 1))
+}
+
+/// The text of `n / 10^decimals` as [`fixed_ascii`] gives it, for any `n`, by a digit
+/// loop: into a buffer, with its length.
+fn fixed_digits(n: u64, decimals: usize) -> ([u8; 24], usize) {
+    let mut buf = [0u8; 24];
+    // At least one digit before the point.
     let digits = n
         .checked_ilog10()
         .map_or(1, |l| l as usize + 1)
         .max(decimals + 1);
-    let int_end = neg + digits - decimals;
-    let len = int_end + point + decimals;
-    let int = put_digits(&mut dst[len - decimals..len], n);
-    if point == 1 {
-        dst[int_end] = b'.';
+    let int_end = digits - decimals;
+    let len = if decimals > 0 { digits + 1 } else { digits };
+    let int = put_digits(&mut buf[len - decimals..len], n);
+    if decimals > 0 {
+        buf[int_end] = b'.';
     }
-    put_digits(&mut dst[neg..int_end], int);
-    Some(len)
+    put_digits(&mut buf[..int_end], int);
+    (buf, len)
 }
 
 /// Append `x` with exactly `decimals` digits after the point, correctly rounded: the
 /// text of std's `{x:.decimals$}`, except that a value rounding to zero has no sign.
-#[inline]
+/// Always inlined, so that constant decimals fold into the arithmetic.
+#[inline(always)]
 pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
-    let mut buf = [0u8; FIXED_MAX_LEN];
-    match fixed_into(&mut buf, x, decimals) {
-        Some(len) => {
-            // The whole buffer, then back to the length: a copy of constant size
-            // (inline moves), where one of `len` bytes would call memcpy.
-            let start = out.len();
-            out.extend_from_slice(&buf);
-            out.truncate(start + len);
-        }
+    let Some(n) = scaled(x, decimals) else {
         // Writing to a Vec cannot fail.
-        None => {
-            let _ = write!(out, "{x:.decimals$}");
-        }
+        let _ = write!(out, "{x:.decimals$}");
+        return;
+    };
+    if x.is_sign_negative() && n != 0 {
+        out.push(b'-');
+    }
+    if let Some((text, len)) = fixed_ascii(n, decimals) {
+        // All 16 bytes (a store of constant size), then back to the length.
+        let start = out.len();
+        out.extend_from_slice(&text.to_le_bytes());
+        out.truncate(start + len);
+    } else {
+        let (buf, len) = fixed_digits(n, decimals);
+        out.extend_from_slice(&buf[..len]);
     }
 }
 
@@ -260,8 +262,9 @@ mod tests {
         assert_eq!(fixed(f64::NAN, 3), "NaN");
         assert_eq!(fixed(f64::NEG_INFINITY, 3), "-inf");
         assert_eq!(fixed(0.1, 25), format!("{:.25}", 0.1));
-        // 15 digits take the lane path, 16 the digit loop.
+        // 14 and 15 digits take the lane path, 16 and more the digit loop.
         assert_eq!(fixed(-1234.5678901234, 11), "-1234.56789012340");
+        assert_eq!(fixed(1234.5678901234, 11), "1234.56789012340");
         assert_eq!(fixed(12345.678901234, 11), "12345.67890123400");
         assert_eq!(fixed(123456789012345.0, 0), "123456789012345");
         assert_eq!(fixed(1234567890123456.0, 0), "1234567890123456");

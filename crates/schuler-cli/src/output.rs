@@ -86,21 +86,21 @@ impl Row {
     /// for latitude and longitude, 1 um for height, 1 um/s for velocity, 1e-9 deg for
     /// attitude: finer than any INS resolves, so files round-trip our results.
     fn push(&self, out: &mut Vec<u8>, sep: u8) {
-        let fields: [(f64, usize); 9] = [
-            (self.lat_deg, 11),
-            (self.lon_deg, 11),
-            (self.h, 6),
-            (self.v[0], 6),
-            (self.v[1], 6),
-            (self.v[2], 6),
-            (self.roll_deg, 9),
-            (self.pitch_deg, 9),
-            (self.yaw_deg, 9),
-        ];
-        for (x, d) in fields {
+        // One call per field, each with its decimals as a constant (push_fixed is
+        // inlined into each), rather than a loop over (value, decimals) pairs.
+        let mut field = |x: f64, decimals: usize| {
             out.push(sep);
-            push_fixed(out, x, d);
-        }
+            push_fixed(out, x, decimals);
+        };
+        field(self.lat_deg, 11);
+        field(self.lon_deg, 11);
+        field(self.h, 6);
+        field(self.v[0], 6);
+        field(self.v[1], 6);
+        field(self.v[2], 6);
+        field(self.roll_deg, 9);
+        field(self.pitch_deg, 9);
+        field(self.yaw_deg, 9);
     }
 }
 
