@@ -499,7 +499,7 @@ mod quadrature_tests {
     /// 1e-10 rad and 3e-7 m/s, over 10^5 times more.
     #[test]
     fn knots_split_the_interval() {
-        use crate::sim::motion::{Piece, Shape, Start, VelocityAxes, generate};
+        use crate::sim::motion::{Piece, Shape, Start, generate};
         let start = Start {
             t: 0.0,
             pos: Geodetic::from_degrees(45.0, 7.0, 100.0),
@@ -507,12 +507,11 @@ mod quadrature_tests {
             attitude: crate::rotation::Euler::default(),
         };
         let turn = Piece {
-            duration: 0.73,
             d_euler: [0.4, 0.1, 0.8],
             d_vel: [3.0, 0.5, -2.0],
-            axes: VelocityAxes::Body,
             shape: Shape::Bump,
             coordinated: true,
+            ..Piece::hold(0.73)
         };
         let traj = generate(&Wgs84, &start, &[turn, turn])
             .expect("motion")

@@ -222,51 +222,38 @@ pub trait Scalar:
     fn recip(self) -> Self;
 }
 
-impl Scalar for f64 {
-    #[inline]
-    fn constant(v: f64) -> Self {
-        v
-    }
-    #[inline]
-    fn value(self) -> f64 {
-        self
-    }
-    #[inline]
-    fn sin_cos(self) -> (Self, Self) {
-        f64::sin_cos(self)
-    }
-    #[inline]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    #[inline]
-    fn recip(self) -> Self {
-        f64::recip(self)
-    }
+/// `impl Scalar` for a type with inherent `sin_cos`, `sqrt` and `recip` (which take
+/// precedence over the trait's in `<$t>::name`), given its constant and value.
+macro_rules! impl_scalar {
+    ($t:ty, |$v:ident| $constant:expr, |$x:ident| $value:expr) => {
+        impl Scalar for $t {
+            #[inline]
+            fn constant($v: f64) -> Self {
+                $constant
+            }
+            #[inline]
+            fn value(self) -> f64 {
+                let $x = self;
+                $value
+            }
+            #[inline]
+            fn sin_cos(self) -> (Self, Self) {
+                <$t>::sin_cos(self)
+            }
+            #[inline]
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            #[inline]
+            fn recip(self) -> Self {
+                <$t>::recip(self)
+            }
+        }
+    };
 }
 
-impl Scalar for Jet {
-    #[inline]
-    fn constant(v: f64) -> Self {
-        Jet::constant(v)
-    }
-    #[inline]
-    fn value(self) -> f64 {
-        self.v
-    }
-    #[inline]
-    fn sin_cos(self) -> (Self, Self) {
-        Jet::sin_cos(self)
-    }
-    #[inline]
-    fn sqrt(self) -> Self {
-        Jet::sqrt(self)
-    }
-    #[inline]
-    fn recip(self) -> Self {
-        Jet::recip(self)
-    }
-}
+impl_scalar!(f64, |v| v, |x| x);
+impl_scalar!(Jet, |v| Jet::constant(v), |x| x.v);
 
 /// `c_bn = Rz(yaw) Ry(pitch) Rx(roll)` on any [`Scalar`] (see
 /// [`crate::rotation::Euler`]), row-major.
