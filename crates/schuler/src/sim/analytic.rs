@@ -366,7 +366,7 @@ pub fn increment<E: EarthModel, T: Trajectory + ?Sized>(
 /// end nodes `±1` weigh 1/6; exact for degree 5). The end nodes are shared by
 /// adjacent intervals, so a stream of samples costs three pose evaluations per sample,
 /// one of which is the truth at the sample time.
-const LOBATTO4_INNER: f64 = 0.447_213_595_499_957_94;
+const LOBATTO4_INNER: f64 = 0.447_213_595_499_957_9;
 
 /// `∫ w_ib_b` and `∫ f_b` over the piece of length `2 half` ending at `end`, given the
 /// kinematics at both ends (4-point Gauss–Lobatto).
