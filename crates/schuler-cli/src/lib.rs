@@ -2,6 +2,7 @@
 //! commands, so that tests and benchmarks drive exactly what the binary runs.
 
 pub mod commands;
+pub mod fixed;
 pub mod formats;
 pub mod output;
 pub mod plot;

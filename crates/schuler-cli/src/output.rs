@@ -19,45 +19,12 @@ use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Geodetic};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
+use schuler::rotation::Euler;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// Append `x` with exactly `decimals` digits after the point, correctly rounded (the
-/// same digits as std's `{:.*}`). The fast path scales by `10^decimals` in floating
-/// point, whose rounding error (half an ulp of the product) can only matter when the
-/// product sits within that error of a half unit; such near-ties, values too large for
-/// the integer path and more than 12 decimals go through `{:.*}`.
-pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
-    const POW10: [f64; 13] = [
-        1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
-    ];
-    let Some(&pow) = POW10.get(decimals) else {
-        let _ = write!(out, "{x:.decimals$}");
-        return;
-    };
-    let product = x.abs() * pow;
-    let scaled = product.round();
-    let near_tie = (product - product.floor() - 0.5).abs() < 1e-3;
-    if near_tie || !scaled.is_finite() || scaled >= 9.0e18 {
-        let _ = write!(out, "{x:.decimals$}");
-        return;
-    }
-    // Exact: scaled < 9e18 < 2^63, an integer-valued f64.
-    let n = scaled as u64;
-    if x.is_sign_negative() && n != 0 {
-        out.push(b'-');
-    }
-    let unit = 10u64.pow(decimals as u32);
-    let mut buf = itoa::Buffer::new();
-    out.extend_from_slice(buf.format(n / unit).as_bytes());
-    if decimals > 0 {
-        out.push(b'.');
-        let frac = buf.format(n % unit).as_bytes();
-        out.extend(std::iter::repeat_n(b'0', decimals - frac.len()));
-        out.extend_from_slice(frac);
-    }
-}
+pub use crate::fixed::push_fixed;
 
 /// Longitude (or any angle) [rad] in degrees, wrapped to (-180, 180]
 /// ([`schuler::rotation::wrap_pi`]).
@@ -99,7 +66,11 @@ struct Row {
 impl Row {
     fn of(s: &NavState) -> Self {
         let s = &s.normalized();
-        let e = s.euler();
+        Self::with_euler(s, &s.euler())
+    }
+
+    /// The row of a state within latitude [-90°, 90°] whose attitude is `e`.
+    fn with_euler(s: &NavState, e: &Euler) -> Self {
         Self {
             lat_deg: s.pos.lat.to_degrees(),
             lon_deg: printable_lon(wrap_lon_deg(s.pos.lon), 11),
@@ -115,21 +86,37 @@ impl Row {
     /// for latitude and longitude, 1 um for height, 1 um/s for velocity, 1e-9 deg for
     /// attitude: finer than any INS resolves, so files round-trip our results.
     fn push(&self, out: &mut Vec<u8>, sep: u8) {
-        let fields: [(f64, usize); 9] = [
-            (self.lat_deg, 11),
-            (self.lon_deg, 11),
-            (self.h, 6),
-            (self.v[0], 6),
-            (self.v[1], 6),
-            (self.v[2], 6),
-            (self.roll_deg, 9),
-            (self.pitch_deg, 9),
-            (self.yaw_deg, 9),
-        ];
-        for (x, d) in fields {
+        // One call per field, each with its decimals as a constant (push_fixed is
+        // inlined into each), rather than a loop over (value, decimals) pairs.
+        let mut field = |x: f64, decimals: usize| {
             out.push(sep);
-            push_fixed(out, x, d);
-        }
+            push_fixed(out, x, decimals);
+        };
+        field(self.lat_deg, 11);
+        field(self.lon_deg, 11);
+        field(self.h, 6);
+        field(self.v[0], 6);
+        field(self.v[1], 6);
+        field(self.v[2], 6);
+        field(self.roll_deg, 9);
+        field(self.pitch_deg, 9);
+        field(self.yaw_deg, 9);
+    }
+}
+
+/// Append the columns of a navigation row after its time, each preceded by `sep`:
+/// lat, lon [deg], h [m], vn, ve, vd [m/s], roll, pitch, yaw [deg], with the decimals
+/// of `nav.txt` (1e-11 deg, 1 um, 1 um/s, 1e-9 deg) and its ranges (latitude in
+/// [-90, 90], longitude in (-180, 180], yaw in [0, 360)). The attitude comes as
+/// Euler angles (`s`'s own, e.g. a trajectory's, in [`Euler::from_dcm`]'s ranges),
+/// which spares three arctangents; a state past a pole is turned by
+/// [`NavState::normalized`], so its attitude then comes from `q_bn`.
+pub fn push_nav_fields(out: &mut Vec<u8>, s: &NavState, e: &Euler, sep: u8) {
+    let n = s.normalized();
+    if n == *s {
+        Row::with_euler(s, e).push(out, sep);
+    } else {
+        Row::with_euler(&n, &n.euler()).push(out, sep);
     }
 }
 
@@ -392,25 +379,6 @@ pub fn write_imu_text(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use proptest::prelude::*;
-
-    fn fixed(x: f64, d: usize) -> String {
-        let mut v = Vec::new();
-        push_fixed(&mut v, x, d);
-        String::from_utf8(v).expect("ascii")
-    }
-
-    #[test]
-    fn fixed_examples() {
-        assert_eq!(fixed(45.07123456789, 11), "45.07123456789");
-        assert_eq!(fixed(-0.0000004, 6), "0.000000");
-        assert_eq!(fixed(-1.5, 0), "-2");
-        // An exact binary tie rounds to even, as std does.
-        assert_eq!(fixed(-12.25, 1), "-12.2");
-        assert_eq!(fixed(0.000123, 6), "0.000123");
-        assert_eq!(fixed(1e300, 3), format!("{:.3}", 1e300));
-        assert_eq!(fixed(f64::NAN, 3), "NaN");
-    }
 
     /// The two IMU line forms: shortest round trip, and fixed significant digits
     /// (what `{:.9}` and `{:.12e}` print).
@@ -509,14 +477,5 @@ mod tests {
         let csv = std::fs::read_to_string(classic.join("nav.csv")).expect("csv");
         assert!(csv.starts_with(&format!("{CSV_HEADER}\n")));
         assert!(csv.lines().all(|l| l.split(',').count() == 10));
-    }
-
-    proptest! {
-        /// The same text as std's `{:.6}` (correct rounding of the exact binary
-        /// value).
-        #[test]
-        fn fixed_agrees_with_std(x in -1e6..1e6f64) {
-            prop_assert_eq!(fixed(x, 6), format!("{x:.6}"));
-        }
     }
 }

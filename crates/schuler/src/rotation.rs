@@ -98,6 +98,28 @@ impl Euler {
         Self::from_dcm(&q_bn.to_rotation_matrix().into_inner())
     }
 
+    /// The same attitude as [`Euler::from_dcm`] gives it, from angles of any range
+    /// (e.g. a trajectory's unwrapped ones) without trigonometry: roll and yaw in
+    /// (−π, π], pitch in [−π/2, π/2] (past ±π/2 the equivalent `(roll + π, ±π −
+    /// pitch, yaw + π)`); within gimbal lock through the DCM, for `from_dcm`'s
+    /// convention there. Angles already in range are returned bit for bit.
+    pub fn principal(&self) -> Self {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let pitch = wrap_pi(self.pitch);
+        // cos(pitch) < GIMBAL_LOCK_COS_PITCH, with room for the rounding of both.
+        if FRAC_PI_2 - pitch.abs() < 2.0 * GIMBAL_LOCK_COS_PITCH {
+            return Self::from_dcm(&self.to_dcm());
+        }
+        if pitch.abs() <= FRAC_PI_2 {
+            return Self::new(wrap_pi(self.roll), pitch, wrap_pi(self.yaw));
+        }
+        Self::new(
+            wrap_pi(self.roll + PI),
+            PI.copysign(pitch) - pitch,
+            wrap_pi(self.yaw + PI),
+        )
+    }
+
     /// Yaw wrapped to [0, 2*pi), the heading convention of navigation output files.
     pub fn heading_0_2pi(&self) -> f64 {
         let y = self.yaw.rem_euclid(std::f64::consts::TAU);
@@ -295,6 +317,33 @@ mod tests {
     }
 
     proptest! {
+        /// Angles of any range: the same rotation as `from_dcm` gives it, within the
+        /// round-off of both (angles of ±10 turns, whose ulp is 1e-14), gimbal lock
+        /// included.
+        #[test]
+        fn principal_is_what_from_dcm_gives(
+            r in -60.0..60.0f64,
+            p in -60.0..60.0f64,
+            y in -60.0..60.0f64,
+            lock in 0usize..4,
+        ) {
+            // Every fourth case at gimbal lock (pitch ±90° plus whole turns).
+            let p = if lock == 0 { FRAC_PI_2 * (2.0 * (p / 20.0).round() + 1.0) } else { p };
+            let e = Euler::new(r, p, y);
+            let got = e.principal();
+            prop_assert!((got.to_dcm() - e.to_dcm()).abs().max() < 1e-13);
+            prop_assert!(got.roll > -PI && got.roll <= PI);
+            prop_assert!(got.yaw > -PI && got.yaw <= PI);
+            prop_assert!(got.pitch.abs() <= FRAC_PI_2);
+            let want = Euler::from_dcm(&e.to_dcm());
+            let d = |a: f64, b: f64| wrap_pi(a - b).abs();
+            prop_assert!(d(got.pitch, want.pitch) < 1e-7, "{got:?} {want:?}");
+            if lock != 0 && FRAC_PI_2 - want.pitch.abs() > 1e-6 {
+                prop_assert!(d(got.roll, want.roll) < 1e-13, "{got:?} {want:?}");
+                prop_assert!(d(got.yaw, want.yaw) < 1e-13, "{got:?} {want:?}");
+            }
+        }
+
         #[test]
         fn euler_dcm_round_trip(r in angle(), p in -1.5..1.5f64, y in angle()) {
             let e = Euler::new(r, p, y);

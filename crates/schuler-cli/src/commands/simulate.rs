@@ -1,25 +1,35 @@
 //! `schuler simulate --config scenario.toml --out DIR`: trajectory, IMU, GNSS and
 //! barometer data with exact truth, in the formats `schuler nav` and KF-GINS read.
 //!
-//! Files (numbers in shortest round-trip form, so nothing is lost):
+//! Files:
 //! - `imu.txt` (KF-GINS: `t dtheta_xyz dvel_xyz`, measured) and `imu.csv` (the same
-//!   with a header);
+//!   with a header), every number in shortest round-trip form: the file reads back to
+//!   the simulated f64s exactly;
 //! - `truth.nav` (KF-GINS navigation format at the IMU rate) and `truth.csv` (adds the
-//!   true angular rate `w_ib_b` and specific force `f_b` at each epoch);
+//!   true angular rate `w_ib_b` and specific force `f_b` at each epoch): time in
+//!   shortest round-trip form (the IMU file's time tags exactly), the state with the
+//!   decimals of `schuler nav`'s own output (1e-11 deg ≈ 1 µm of latitude and
+//!   longitude, 1 µm height, 1 µm/s velocity, 1e-9 deg attitude), `w_ib_b` to 1e-12
+//!   rad/s (2e-7 deg/h) and `f_b` to 1e-10 m/s^2 (1e-11 g): rounding leaves at most half
+//!   of each, below what any navigation error worth measuring comes to (the
+//!   perfect-sensor round trip through `schuler nav` stays at a fraction of a
+//!   millimetre after 30 min) and far below the biases of a navigation-grade IMU
+//!   (0.01 deg/h, 50 µg);
 //! - `gnss.txt` (KF-GINS: `t lat lon h std_n std_e std_d`) and `gnss.csv` (adds the
 //!   velocity and its std and the outlier flag);
 //! - `baro.csv` (`t,h_m,outlier`);
 //! - `scenario.resolved.toml`: every parameter actually used, seed included.
 //!
-//! The same scenario and seed give the same bytes.
+//! Blocks of samples are formatted on the simulator's workers, each block while others
+//! are computed or written, and written in time order
+//! ([`schuler::sim::run::simulate_with`]). The same scenario and seed give the same
+//! bytes.
 
-use crate::output::{ImuDigits, push_imu_line};
+use crate::fixed::push_fixed;
+use crate::output::{ImuDigits, push_imu_line, push_nav_fields};
 use anyhow::{Context, Result};
-use schuler::imu::ImuSample;
-use schuler::nav::NavState;
-use schuler::sim::analytic::Kinematics;
-use schuler::sim::receivers::{BaroReading, GnssFix};
-use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, SimSink, simulate};
+use schuler::sim::receivers::GnssFix;
+use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -55,6 +65,13 @@ impl Out {
         })
     }
 
+    /// Write `bytes`; an error names the file.
+    fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.w
+            .write_all(bytes)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", self.path.display())))
+    }
+
     fn finish(mut self) -> Result<()> {
         self.w
             .flush()
@@ -62,195 +79,201 @@ impl Out {
     }
 }
 
-/// Appends numbers separated by `sep` in shortest round-trip form.
-struct Line {
-    buf: Vec<u8>,
-    num: zmij::Buffer,
-}
+/// Decimals of the true angular rate in `truth.csv` (1e-12 rad/s).
+const W_DECIMALS: usize = 12;
+/// Decimals of the true specific force in `truth.csv` (1e-10 m/s^2).
+const F_DECIMALS: usize = 10;
 
-impl Line {
-    fn new() -> Self {
-        Self {
-            buf: Vec::with_capacity(512),
-            num: zmij::Buffer::new(),
-        }
-    }
-
-    fn start(&mut self) -> &mut Self {
-        self.buf.clear();
-        self
-    }
-
-    fn num(&mut self, x: f64, sep: u8) -> &mut Self {
-        if !self.buf.is_empty() {
-            self.buf.push(sep);
-        }
-        self.buf.extend_from_slice(self.num.format(x).as_bytes());
-        self
-    }
-
-    fn nums(&mut self, xs: &[f64], sep: u8) -> &mut Self {
-        for &x in xs {
-            self.num(x, sep);
-        }
-        self
-    }
-
-    fn write(&mut self, out: &mut Out) -> std::io::Result<()> {
-        self.buf.push(b'\n');
-        out.w.write_all(&self.buf)
+/// `bytes` with every space turned into a comma, appended to `out`.
+fn push_as_csv(out: &mut Vec<u8>, bytes: &[u8]) {
+    let start = out.len();
+    out.extend_from_slice(bytes);
+    // An unconditional store per byte, so the loop runs on vector lanes.
+    for b in &mut out[start..] {
+        *b = if *b == b' ' { b',' } else { *b };
     }
 }
 
-/// Output columns of a navigation state in KF-GINS units (deg, m, m/s, deg; yaw in
-/// [0, 360)).
-fn nav_fields(s: &NavState) -> [f64; 9] {
-    let e = s.euler();
-    [
-        s.pos.lat.to_degrees(),
-        s.pos.lon.to_degrees(),
-        s.pos.h,
-        s.v_n.x,
-        s.v_n.y,
-        s.v_n.z,
-        e.roll.to_degrees(),
-        e.pitch.to_degrees(),
-        e.heading_0_2pi().to_degrees(),
-    ]
+/// `imu.txt` and `imu.csv` lines of the measured samples of `epochs`. Each number is
+/// formatted once: the CSV line is the same bytes with commas for spaces (no number
+/// contains either).
+fn imu_lines(epochs: &[ImuEpoch], txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
+    let start = txt.len();
+    for e in epochs {
+        push_imu_line(txt, &e.measured, b' ', ImuDigits::Shortest);
+        txt.push(b'\n');
+    }
+    push_as_csv(csv, &txt[start..]);
 }
 
-/// The text of consecutive IMU epochs for the four per-epoch files.
-///
-/// Each number is formatted once: the CSV twin of a line is the same bytes with
-/// commas for spaces (no number contains either).
+/// `truth.nav` lines (week 0, then `t lat lon h vn ve vd roll pitch yaw`) and
+/// `truth.csv` lines (the same after the week, then `w_ib_b` and `f_b`) of `epochs`.
+fn truth_lines(epochs: &[ImuEpoch], nav: &mut Vec<u8>, csv: &mut Vec<u8>) {
+    let mut num = zmij::Buffer::new();
+    for e in epochs {
+        nav.extend_from_slice(b"0 ");
+        let start = nav.len();
+        nav.extend_from_slice(num.format(e.truth.t).as_bytes());
+        push_nav_fields(nav, &e.truth, &e.euler, b' ');
+        push_as_csv(csv, &nav[start..]);
+        nav.push(b'\n');
+        let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
+        for x in [w.x, w.y, w.z] {
+            csv.push(b',');
+            push_fixed(csv, x, W_DECIMALS);
+        }
+        for x in [f.x, f.y, f.z] {
+            csv.push(b',');
+            push_fixed(csv, x, F_DECIMALS);
+        }
+        csv.push(b'\n');
+    }
+}
+
+/// Append `xs` in shortest round-trip form separated by `sep`, then a newline.
+fn push_shortest_line(out: &mut Vec<u8>, xs: &[f64], sep: u8) {
+    let mut num = zmij::Buffer::new();
+    for (i, &x) in xs.iter().enumerate() {
+        if i > 0 {
+            out.push(sep);
+        }
+        out.extend_from_slice(num.format(x).as_bytes());
+    }
+    out.push(b'\n');
+}
+
+/// `gnss.txt` (`t lat lon h std_n std_e std_d`) and `gnss.csv` (the same, then the
+/// velocity, its std and the outlier flag) lines of a fix.
+fn gnss_lines(fix: &GnssFix, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
+    let (p, sd, v, vsd) = (fix.pos, fix.pos_std, fix.v_n, fix.vel_std);
+    let row = [
+        fix.t,
+        p.lat.to_degrees(),
+        p.lon.to_degrees(),
+        p.h,
+        sd.x,
+        sd.y,
+        sd.z,
+        v.x,
+        v.y,
+        v.z,
+        vsd.x,
+        vsd.y,
+        vsd.z,
+        f64::from(u8::from(fix.outlier)),
+    ];
+    push_shortest_line(txt, &row[..7], b' ');
+    push_shortest_line(csv, &row, b',');
+}
+
+/// The text of one block for every file (one per worker, its memory reused from block
+/// to block).
 #[derive(Default)]
-struct EpochText {
+struct BlockText {
     imu_txt: Vec<u8>,
     imu_csv: Vec<u8>,
     truth_nav: Vec<u8>,
     truth_csv: Vec<u8>,
+    gnss_txt: Vec<u8>,
+    gnss_csv: Vec<u8>,
+    baro_csv: Vec<u8>,
 }
 
-/// `bytes` with every space turned into a comma, appended to `out`.
-fn push_as_csv(out: &mut Vec<u8>, bytes: &[u8]) {
-    out.extend(bytes.iter().map(|&b| if b == b' ' { b',' } else { b }));
-}
-
-impl EpochText {
-    fn clear(&mut self) {
-        self.imu_txt.clear();
-        self.imu_csv.clear();
-        self.truth_nav.clear();
-        self.truth_csv.clear();
-    }
-
-    /// Append the lines of `epochs`.
-    fn push(&mut self, epochs: &[ImuEpoch]) {
-        let mut num = zmij::Buffer::new();
-        for e in epochs {
-            // imu.txt (KF-GINS) and imu.csv: the measured sample.
-            let start = self.imu_txt.len();
-            push_imu_line(&mut self.imu_txt, &e.measured, b' ', ImuDigits::Shortest);
-            self.imu_txt.push(b'\n');
-            push_as_csv(&mut self.imu_csv, &self.imu_txt[start..]);
-            // truth.nav: week 0, then `t lat lon h vn ve vd roll pitch yaw`; truth.csv:
-            // the same after the week, then w_ib_b and f_b.
-            self.truth_nav.extend_from_slice(b"0 ");
-            let start = self.truth_nav.len();
-            self.truth_nav
-                .extend_from_slice(num.format(e.truth.t).as_bytes());
-            for x in nav_fields(&e.truth) {
-                self.truth_nav.push(b' ');
-                self.truth_nav.extend_from_slice(num.format(x).as_bytes());
-            }
-            push_as_csv(&mut self.truth_csv, &self.truth_nav[start..]);
-            self.truth_nav.push(b'\n');
-            let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
-            for x in [w.x, w.y, w.z, f.x, f.y, f.z] {
-                self.truth_csv.push(b',');
-                self.truth_csv.extend_from_slice(num.format(x).as_bytes());
-            }
-            self.truth_csv.push(b'\n');
+impl BlockText {
+    /// The lines of `block` for every file.
+    fn format(&mut self, block: &SimBlock) {
+        for b in [
+            &mut self.imu_txt,
+            &mut self.imu_csv,
+            &mut self.truth_nav,
+            &mut self.truth_csv,
+            &mut self.gnss_txt,
+            &mut self.gnss_csv,
+            &mut self.baro_csv,
+        ] {
+            b.clear();
+        }
+        imu_lines(&block.imu, &mut self.imu_txt, &mut self.imu_csv);
+        truth_lines(&block.imu, &mut self.truth_nav, &mut self.truth_csv);
+        for (_, fix) in &block.gnss {
+            gnss_lines(fix, &mut self.gnss_txt, &mut self.gnss_csv);
+        }
+        for (_, r) in &block.baro {
+            let row = [r.t, r.h, f64::from(u8::from(r.outlier))];
+            push_shortest_line(&mut self.baro_csv, &row, b',');
         }
     }
 }
 
-/// Writes every stream to its files.
-struct FileSink {
+/// Every output file.
+struct Files {
     imu_txt: Out,
     imu_csv: Out,
     truth_nav: Out,
     truth_csv: Out,
-    gnss_txt: Option<(Out, Out)>,
+    gnss: Option<(Out, Out)>,
     baro_csv: Option<Out>,
-    line: Line,
-    /// Text buffers, one per formatting thread (reused from block to block).
-    text: Vec<EpochText>,
 }
 
-impl FileSink {
+impl Files {
     fn create(dir: &Path, gnss: bool, baro: bool) -> Result<Self> {
-        let threads = std::thread::available_parallelism()
-            .map_or(1, usize::from)
-            .clamp(1, 8);
-        let mut s = Self {
+        let with_header = |name: &str, header: &str| -> Result<Out> {
+            let mut o = Out::create(dir, name)?;
+            writeln!(o.w, "{header}")
+                .with_context(|| format!("cannot write {}", o.path.display()))?;
+            Ok(o)
+        };
+        Ok(Self {
             imu_txt: Out::create(dir, "imu.txt")?,
-            imu_csv: Out::create(dir, "imu.csv")?,
+            imu_csv: with_header(
+                "imu.csv",
+                "t,dtheta_x,dtheta_y,dtheta_z,dvel_x,dvel_y,dvel_z",
+            )?,
             truth_nav: Out::create(dir, "truth.nav")?,
-            truth_csv: Out::create(dir, "truth.csv")?,
-            gnss_txt: if gnss {
-                Some((Out::create(dir, "gnss.txt")?, Out::create(dir, "gnss.csv")?))
+            truth_csv: with_header(
+                "truth.csv",
+                "t,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,w_x,w_y,w_z,f_x,f_y,f_z",
+            )?,
+            gnss: if gnss {
+                Some((
+                    Out::create(dir, "gnss.txt")?,
+                    with_header(
+                        "gnss.csv",
+                        "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier",
+                    )?,
+                ))
             } else {
                 None
             },
             baro_csv: if baro {
-                Some(Out::create(dir, "baro.csv")?)
+                Some(with_header("baro.csv", "t,h_m,outlier")?)
             } else {
                 None
             },
-            line: Line::new(),
-            text: (0..threads).map(|_| EpochText::default()).collect(),
-        };
-        let header = |o: &mut Out, h: &str| {
-            writeln!(o.w, "{h}").with_context(|| format!("cannot write {}", o.path.display()))
-        };
-        header(
-            &mut s.imu_csv,
-            "t,dtheta_x,dtheta_y,dtheta_z,dvel_x,dvel_y,dvel_z",
-        )?;
-        header(
-            &mut s.truth_csv,
-            "t,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,w_x,w_y,w_z,f_x,f_y,f_z",
-        )?;
-        if let Some((_, csv)) = s.gnss_txt.as_mut() {
-            header(
-                csv,
-                "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier",
-            )?;
-        }
-        if let Some(b) = s.baro_csv.as_mut() {
-            header(b, "t,h_m,outlier")?;
-        }
-        Ok(s)
+        })
     }
 
-    /// Write the formatted text of the first `parts` buffers, in order.
-    fn write_text(&mut self, parts: usize) -> std::io::Result<()> {
-        for t in &self.text[..parts] {
-            self.imu_txt.w.write_all(&t.imu_txt)?;
-            self.imu_csv.w.write_all(&t.imu_csv)?;
-            self.truth_nav.w.write_all(&t.truth_nav)?;
-            self.truth_csv.w.write_all(&t.truth_csv)?;
+    /// Write a block's text to every file; an error names the file.
+    fn write(&mut self, t: &BlockText) -> std::io::Result<()> {
+        self.imu_txt.write_all(&t.imu_txt)?;
+        self.imu_csv.write_all(&t.imu_csv)?;
+        self.truth_nav.write_all(&t.truth_nav)?;
+        self.truth_csv.write_all(&t.truth_csv)?;
+        if let Some((txt, csv)) = self.gnss.as_mut() {
+            txt.write_all(&t.gnss_txt)?;
+            csv.write_all(&t.gnss_csv)?;
+        }
+        if let Some(b) = self.baro_csv.as_mut() {
+            b.write_all(&t.baro_csv)?;
         }
         Ok(())
     }
 
     fn finish(self) -> Result<()> {
-        self.imu_txt.finish()?;
-        self.imu_csv.finish()?;
-        self.truth_nav.finish()?;
-        self.truth_csv.finish()?;
-        if let Some((a, b)) = self.gnss_txt {
+        for o in [self.imu_txt, self.imu_csv, self.truth_nav, self.truth_csv] {
+            o.finish()?;
+        }
+        if let Some((a, b)) = self.gnss {
             a.finish()?;
             b.finish()?;
         }
@@ -258,102 +281,6 @@ impl FileSink {
             b.finish()?;
         }
         Ok(())
-    }
-}
-
-impl SimSink for FileSink {
-    fn imu(
-        &mut self,
-        exact: &ImuSample,
-        measured: &ImuSample,
-        truth: &NavState,
-        kin: &Kinematics,
-    ) -> std::io::Result<()> {
-        self.text[0].clear();
-        self.text[0].push(&[ImuEpoch {
-            exact: *exact,
-            measured: *measured,
-            truth: *truth,
-            kin: *kin,
-        }]);
-        self.write_text(1)
-    }
-
-    /// The GNSS and barometer epochs (a few) as they come; the IMU epochs formatted
-    /// in parallel chunks, then written in order: the same bytes as one at a time.
-    fn block(&mut self, block: &SimBlock) -> std::io::Result<()> {
-        for (_, fix) in &block.gnss {
-            self.gnss(fix)?;
-        }
-        for (_, r) in &block.baro {
-            self.baro(r)?;
-        }
-        let chunk = block.imu.len().div_ceil(self.text.len()).max(1);
-        let mut parts = 0;
-        std::thread::scope(|scope| {
-            let mut jobs = block.imu.chunks(chunk).zip(self.text.iter_mut());
-            // The first chunk on this thread, the others on their own.
-            let first = jobs.next();
-            for (epochs, text) in jobs {
-                parts += 1;
-                scope.spawn(move || {
-                    text.clear();
-                    text.push(epochs);
-                });
-            }
-            if let Some((epochs, text)) = first {
-                parts += 1;
-                text.clear();
-                text.push(epochs);
-            }
-        });
-        self.write_text(parts)
-    }
-
-    fn gnss(&mut self, fix: &GnssFix) -> std::io::Result<()> {
-        let Some((txt, csv)) = self.gnss_txt.as_mut() else {
-            return Ok(());
-        };
-        let pos = [
-            fix.pos.lat.to_degrees(),
-            fix.pos.lon.to_degrees(),
-            fix.pos.h,
-        ];
-        let sd = [fix.pos_std.x, fix.pos_std.y, fix.pos_std.z];
-        self.line
-            .start()
-            .num(fix.t, b' ')
-            .nums(&pos, b' ')
-            .nums(&sd, b' ')
-            .write(txt)?;
-        let v = [
-            fix.v_n.x,
-            fix.v_n.y,
-            fix.v_n.z,
-            fix.vel_std.x,
-            fix.vel_std.y,
-            fix.vel_std.z,
-        ];
-        self.line
-            .start()
-            .num(fix.t, b',')
-            .nums(&pos, b',')
-            .nums(&sd, b',')
-            .nums(&v, b',')
-            .num(f64::from(u8::from(fix.outlier)), b',')
-            .write(csv)
-    }
-
-    fn baro(&mut self, r: &BaroReading) -> std::io::Result<()> {
-        let Some(out) = self.baro_csv.as_mut() else {
-            return Ok(());
-        };
-        self.line
-            .start()
-            .num(r.t, b',')
-            .num(r.h, b',')
-            .num(f64::from(u8::from(r.outlier)), b',')
-            .write(out)
     }
 }
 
@@ -378,10 +305,14 @@ pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
 /// Simulate `spec` into `dir`; returns the summary.
 pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::run::SimSummary> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let mut sink = FileSink::create(dir, spec.gnss.is_some(), spec.baro.is_some())?;
-    let summary = simulate(spec, &mut sink);
+    let mut files = Files::create(dir, spec.gnss.is_some(), spec.baro.is_some())?;
+    let summary = simulate_with(
+        spec,
+        |block, text: &mut BlockText| text.format(block),
+        |text| files.write(text),
+    );
     // Flush what was written even when the simulation stopped early.
-    let flushed = sink.finish();
+    let flushed = files.finish();
     let summary = summary?;
     flushed?;
     let resolved =

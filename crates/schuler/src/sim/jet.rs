@@ -196,6 +196,95 @@ impl Add<Jet> for f64 {
     }
 }
 
+/// What one formula needs of its numbers so that it runs on plain values (`f64`) and
+/// on jets (`Jet`) alike: the value part of every `Jet` operation is the `f64`
+/// operation on the values, so both give the same value bits (division is written
+/// `a * b.recip()`, as `Jet` divides).
+pub trait Scalar:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+{
+    /// A constant.
+    fn constant(v: f64) -> Self;
+    /// The value.
+    fn value(self) -> f64;
+    /// Sine and cosine.
+    fn sin_cos(self) -> (Self, Self);
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Reciprocal `1/x`.
+    fn recip(self) -> Self;
+}
+
+/// `impl Scalar` for a type with inherent `sin_cos`, `sqrt` and `recip` (which take
+/// precedence over the trait's in `<$t>::name`), given its constant and value.
+macro_rules! impl_scalar {
+    ($t:ty, |$v:ident| $constant:expr, |$x:ident| $value:expr) => {
+        impl Scalar for $t {
+            #[inline]
+            fn constant($v: f64) -> Self {
+                $constant
+            }
+            #[inline]
+            fn value(self) -> f64 {
+                let $x = self;
+                $value
+            }
+            #[inline]
+            fn sin_cos(self) -> (Self, Self) {
+                <$t>::sin_cos(self)
+            }
+            #[inline]
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            #[inline]
+            fn recip(self) -> Self {
+                <$t>::recip(self)
+            }
+        }
+    };
+}
+
+impl_scalar!(f64, |v| v, |x| x);
+impl_scalar!(Jet, |v| Jet::constant(v), |x| x.v);
+
+/// `c_bn = Rz(yaw) Ry(pitch) Rx(roll)` on any [`Scalar`] (see
+/// [`crate::rotation::Euler`]), row-major.
+pub fn euler_dcm<S: Scalar>(roll: S, pitch: S, yaw: S) -> [[S; 3]; 3] {
+    euler_dcm_sin_cos(roll.sin_cos(), pitch.sin_cos(), yaw.sin_cos())
+}
+
+/// [`euler_dcm`] from the angles' `(sin, cos)` pairs, for a caller that needs them
+/// too.
+pub fn euler_dcm_sin_cos<S: Scalar>(
+    (sr, cr): (S, S),
+    (sp, cp): (S, S),
+    (sy, cy): (S, S),
+) -> [[S; 3]; 3] {
+    [
+        [cp * cy, -(cr * sy) + sr * sp * cy, sr * sy + cr * sp * cy],
+        [cp * sy, cr * cy + sr * sp * sy, -(sr * cy) + cr * sp * sy],
+        [-sp, sr * cp, cr * cp],
+    ]
+}
+
+/// Matrix (row-major) times vector, `m x`, on any [`Scalar`].
+pub fn mat_vec<S: Scalar>(m: &[[S; 3]; 3], x: &[S; 3]) -> [S; 3] {
+    [0, 1, 2].map(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+}
+
+/// Transposed matrix (row-major) times vector, `mᵀ x`, on any [`Scalar`].
+pub fn mat_t_vec<S: Scalar>(m: &[[S; 3]; 3], x: &[S; 3]) -> [S; 3] {
+    [0, 1, 2].map(|i| m[0][i] * x[0] + m[1][i] * x[1] + m[2][i] * x[2])
+}
+
 /// A 3-vector of jets.
 pub type JetVec3 = [Jet; 3];
 
@@ -218,8 +307,7 @@ impl JetMat3 {
 
     /// Matrix times vector.
     pub fn mul_vec(&self, x: &JetVec3) -> JetVec3 {
-        let m = &self.0;
-        [0, 1, 2].map(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+        mat_vec(&self.0, x)
     }
 
     /// Transpose.
@@ -240,14 +328,7 @@ impl JetMat3 {
 
     /// `c_bn = Rz(yaw) Ry(pitch) Rx(roll)` with jets (see [`crate::rotation::Euler`]).
     pub fn from_euler(roll: Jet, pitch: Jet, yaw: Jet) -> Self {
-        let (sr, cr) = roll.sin_cos();
-        let (sp, cp) = pitch.sin_cos();
-        let (sy, cy) = yaw.sin_cos();
-        Self([
-            [cp * cy, -(cr * sy) + sr * sp * cy, sr * sy + cr * sp * cy],
-            [cp * sy, cr * cy + sr * sp * sy, -(sr * cy) + cr * sp * sy],
-            [-sp, sr * cp, cr * cp],
-        ])
+        Self(euler_dcm(roll, pitch, yaw))
     }
 
     /// Rotation by angle `angle` about the unit axis `u` (Rodrigues):

@@ -19,7 +19,7 @@
 //! second derivatives of the state there (forward-mode jets through the same equations),
 //! so the [`SplineTrajectory`] through the knots is the truth.
 
-use super::jet::{Jet, JetMat3};
+use super::jet::{self, Jet, Scalar};
 use super::spline::{Knot, SplineTrajectory};
 use crate::earth::{EarthModel, Geodetic};
 use crate::rotation::Euler;
@@ -41,18 +41,18 @@ pub enum Shape {
 }
 
 impl Shape {
-    /// The shape's value at `x = τ/T` in [0, 1], as a jet.
-    fn eval(self, x: Jet) -> Jet {
-        let one = Jet::constant(1.0);
+    /// The shape's value at `x = τ/T` in [0, 1], on a value or a jet.
+    fn eval<S: Scalar>(self, x: S) -> S {
+        let one = S::constant(1.0);
         match self {
-            Shape::Zero => Jet::constant(0.0),
+            Shape::Zero => S::constant(0.0),
             Shape::Bump => x * x * (one - x) * (one - x) * 30.0,
             Shape::Plateau(f) => {
                 // Smoothstep S(s) = 6s^5 - 15s^4 + 10s^3 (C2 at both ends).
-                let step = |s: Jet| s * s * s * (s * (s * 6.0 - 15.0) + 10.0);
-                let w = if x.v < f {
+                let step = |s: S| s * s * s * (s * (s * 6.0 - 15.0) + 10.0);
+                let w = if x.value() < f {
                     step(x * (1.0 / f))
-                } else if x.v > 1.0 - f {
+                } else if x.value() > 1.0 - f {
                     step((one - x) * (1.0 / f))
                 } else {
                     one
@@ -110,22 +110,23 @@ const G_TURN: f64 = 9.806_65;
 /// Below this horizontal speed [m/s] a coordinated piece adds no yaw rate.
 const MIN_TURN_SPEED: f64 = 0.1;
 
-/// The state derivative `x'` at time `tau` into `piece`, on jets so that the
-/// derivative of the result is `x''`.
-fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -> [Jet; 9] {
+/// The state derivative `x'` at time `tau` into `piece`: on values for the
+/// Runge–Kutta stages, on jets so that the derivative of the result is `x''` (the same
+/// value bits either way, [`Scalar`]).
+fn derivative<E: EarthModel, S: Scalar>(earth: &E, piece: &Piece, tau: S, x: &[S; 9]) -> [S; 9] {
     let [lat, _lon, h, roll, pitch, yaw, vn, ve, vd] = *x;
     let (a, e2) = (earth.semi_major_axis(), earth.eccentricity_squared());
     let (sl, cl) = lat.sin_cos();
     let (sr, cr) = roll.sin_cos();
-    let w = (Jet::constant(1.0) - sl * sl * e2).sqrt();
+    let w = (S::constant(1.0) - sl * sl * e2).sqrt();
     let rn = w.recip() * a;
     let rm = (w * w * w).recip() * (a * (1.0 - e2));
     let s = piece.shape.eval(tau * (1.0 / piece.duration)) * (1.0 / piece.duration);
     let mut euler_rate = piece.d_euler.map(|d| s * d);
     if piece.coordinated {
         let v_h = (vn * vn + ve * ve).sqrt();
-        if v_h.v > MIN_TURN_SPEED {
-            euler_rate[2] = euler_rate[2] + sr / cr * G_TURN / v_h;
+        if v_h.value() > MIN_TURN_SPEED {
+            euler_rate[2] = euler_rate[2] + sr * cr.recip() * G_TURN * v_h.recip();
         }
     }
     let accel = piece.d_vel.map(|d| s * d);
@@ -133,23 +134,26 @@ fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -
     let a_n = match piece.axes {
         VelocityAxes::Ned => accel,
         VelocityAxes::Body => {
-            let c_bn = JetMat3::from_euler(roll, pitch, yaw);
-            let v_b = c_bn.transpose().mul_vec(&v_n);
+            let (sp, cp) = pitch.sin_cos();
+            let c_bn = jet::euler_dcm_sin_cos((sr, cr), (sp, cp), yaw.sin_cos());
+            let v_b = jet::mat_t_vec(&c_bn, &v_n);
             // w_nb_b from Euler rates (Titterton & Weston eq. 3.52 inverted).
             let [dr, dp, dy] = euler_rate;
-            let (sp, cp) = pitch.sin_cos();
             let w = [dr - dy * sp, dp * cr + dy * sr * cp, dy * cr * cp - dp * sr];
             let wxv = [
                 w[1] * v_b[2] - w[2] * v_b[1],
                 w[2] * v_b[0] - w[0] * v_b[2],
                 w[0] * v_b[1] - w[1] * v_b[0],
             ];
-            c_bn.mul_vec(&[accel[0] + wxv[0], accel[1] + wxv[1], accel[2] + wxv[2]])
+            jet::mat_vec(
+                &c_bn,
+                &[accel[0] + wxv[0], accel[1] + wxv[1], accel[2] + wxv[2]],
+            )
         }
     };
     [
-        vn / (rm + h),
-        ve / ((rn + h) * cl),
+        vn * (rm + h).recip(),
+        ve * ((rn + h) * cl).recip(),
         -vd,
         euler_rate[0],
         euler_rate[1],
@@ -160,9 +164,9 @@ fn derivative<E: EarthModel>(earth: &E, piece: &Piece, tau: Jet, x: &[Jet; 9]) -
     ]
 }
 
-/// Values of the derivative at plain f64 state.
+/// Values of the derivative at plain f64 state (no jets: a third of the work).
 fn derivative_value<E: EarthModel>(earth: &E, piece: &Piece, tau: f64, x: &[f64; 9]) -> [f64; 9] {
-    derivative(earth, piece, Jet::constant(tau), &x.map(Jet::constant)).map(|j| j.v)
+    derivative(earth, piece, tau, x)
 }
 
 /// The knot at state `x` whose first derivatives `d1` come from the equations:

@@ -19,6 +19,8 @@ pub fn splitmix64(state: &mut u64) -> u64 {
 pub struct Noise {
     rng: ChaCha8Rng,
     spare: Option<f64>,
+    /// The ziggurat's layer edges, looked up once.
+    edges: &'static [f64; ZIG_LAYERS + 1],
 }
 
 impl Noise {
@@ -32,6 +34,7 @@ impl Noise {
         Self {
             rng: ChaCha8Rng::from_seed(key),
             spare: None,
+            edges: ziggurat_edges(),
         }
     }
 
@@ -87,7 +90,7 @@ impl Noise {
     /// [`Noise::normal`], for the per-sample sensor noise; another sequence of variates
     /// from the same stream.
     pub fn normal_ziggurat(&mut self) -> f64 {
-        let x = ziggurat_edges();
+        let x = self.edges;
         loop {
             let bits: u64 = self.rng.random();
             let i = (bits & 0xff) as usize;

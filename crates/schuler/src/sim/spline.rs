@@ -100,12 +100,15 @@ impl SplineTrajectory {
     /// shorter only at the ends of pieces), so the search starts from the proportional
     /// guess and gallops outwards to a bracket before bisecting it: a few steps in
     /// place of a dozen scattered ones, for any spacing.
+    #[inline]
     fn interval(&self, t: f64) -> usize {
         let times = &self.times;
         let last = times.len() - 2; // the last interval
         let (first_t, last_t) = (times[0], times[last + 1]);
-        let guess = ((t - first_t) / (last_t - first_t) * (last + 1) as f64).floor();
-        // `as` saturates (NaN to 0), then clamp into the intervals.
+        let guess = (t - first_t) / (last_t - first_t) * (last + 1) as f64;
+        // `as` truncates, which is the floor from 0 up, and saturates (negatives and
+        // NaN to 0); then clamp into the intervals. (No `floor()`: without SSE4.1 it is
+        // a call into libm.)
         let guess = (guess as usize).min(last);
         // Bracket [lo, hi) of candidate counts of knots with time <= t, minus one.
         let (mut lo, mut hi);
@@ -132,66 +135,102 @@ impl SplineTrajectory {
         lo + times[lo + 1..hi.max(lo + 1)].partition_point(|&x| x <= t)
     }
 
-    /// All six components at time `t` with their first and second time derivatives,
-    /// `[value, rate, acceleration]` each, from the basis derivatives in closed form.
-    pub fn derivatives(&self, t: f64) -> [[f64; 3]; 6] {
+    /// The knots around `t`, their spacing `h` and `s = (t - t_0)/h` in [0, 1].
+    #[inline]
+    fn locate(&self, t: f64) -> (&Knot, &Knot, f64, f64) {
         let i = self.interval(t);
         let (k0, k1) = (&self.knots[i], &self.knots[i + 1]);
         let h = k1.t - k0.t;
-        let s = (t - k0.t) / h;
+        (k0, k1, h, (t - k0.t) / h)
+    }
+
+    /// The quintic Hermite basis at `s`, for the weights of `p1 - p0`, `h p0'`,
+    /// `h^2 p0''`, `h^2 p1''`, `h p1'`: H5 (the value enters as `p0 + H5 (p1 - p0)`,
+    /// see [`Self::basis_sum`]), H1, H2, H3, H4, each factored so that it is computed
+    /// without cancellation.
+    #[inline]
+    fn value_basis(s: f64) -> [f64; 5] {
         let u = 1.0 - s;
         let (s2, u2) = (s * s, u * u);
         let s3 = s2 * s;
-        // Quintic Hermite basis and its derivatives in s, factored so each is computed
-        // without cancellation: H5 (value, p0 + H5 (p1 - p0), see below), H1 (h p0'),
-        // H2 (h^2 p0''), H3 (h^2 p1''), H4 (h p1').
-        let b = [
-            // [H, H', H'']
+        [
+            s3 * (10.0 + s * (6.0 * s - 15.0)),
+            s * (1.0 + s2 * (s * (8.0 - 3.0 * s) - 6.0)),
+            0.5 * s2 * u2 * u,
+            0.5 * s3 * u2,
+            -s3 * u * (4.0 - 3.0 * s),
+        ]
+    }
+
+    /// [`Self::value_basis`] with its first and second derivatives in `s`, `[H, H',
+    /// H'']` per basis function.
+    #[inline]
+    fn basis(s: f64) -> [[f64; 3]; 5] {
+        let v = Self::value_basis(s);
+        let u = 1.0 - s;
+        let (s2, u2) = (s * s, u * u);
+        [
+            [v[0], 30.0 * s2 * u2, 60.0 * s * u * (1.0 - 2.0 * s)],
             [
-                s3 * (10.0 + s * (6.0 * s - 15.0)),
-                30.0 * s2 * u2,
-                60.0 * s * u * (1.0 - 2.0 * s),
-            ],
-            [
-                s * (1.0 + s2 * (s * (8.0 - 3.0 * s) - 6.0)),
+                v[1],
                 u2 * (1.0 + s * (2.0 - 15.0 * s)),
                 -12.0 * s * u * (3.0 - 5.0 * s),
             ],
             [
-                0.5 * s2 * u2 * u,
+                v[2],
                 s * u2 * (1.0 - 2.5 * s),
                 u * (1.0 + s * (10.0 * s - 8.0)),
             ],
             [
-                0.5 * s3 * u2,
+                v[3],
                 0.5 * s2 * u * (3.0 - 5.0 * s),
                 s * (3.0 + s * (10.0 * s - 12.0)),
             ],
             [
-                -s3 * u * (4.0 - 3.0 * s),
+                v[4],
                 -s2 * (12.0 + s * (15.0 * s - 28.0)),
                 -12.0 * s * u * (2.0 - 5.0 * s),
             ],
+        ]
+    }
+
+    /// Component `c`'s basis sum `Σ w_k b_k` over a piece: with the basis values
+    /// ([`Self::value_basis`]) the change from `p0`, with their first (second)
+    /// derivatives `h` (`h^2`) times the rate (acceleration). The value enters as `p0 + H5 (p1 - p0)` (`H0 = 1 - H5`):
+    /// written as `H0 p0 + H5 p1` the derivatives would cancel two large terms (for a
+    /// latitude of 0.8 rad at 100 Hz knots, 3e-4 m/s^2 of round-off in the
+    /// acceleration).
+    #[inline]
+    fn basis_sum(k0: &Knot, k1: &Knot, h: f64, b: [f64; 5], c: usize) -> f64 {
+        let hh = h * h;
+        let w = [
+            k1.value[c] - k0.value[c],
+            h * k0.rate[c],
+            hh * k0.accel[c],
+            hh * k1.accel[c],
+            h * k1.rate[c],
         ];
+        w[0] * b[0] + w[1] * b[1] + w[2] * b[2] + w[3] * b[3] + w[4] * b[4]
+    }
+
+    /// All six components at time `t` with their first and second time derivatives,
+    /// `[value, rate, acceleration]` each, from the basis derivatives in closed form.
+    pub fn derivatives(&self, t: f64) -> [[f64; 3]; 6] {
+        let (k0, k1, h, s) = self.locate(t);
+        let b = Self::basis(s);
+        let column = |j: usize| b.map(|f| f[j]);
+        let (b0, b1, b2) = (column(0), column(1), column(2));
         // d/dt = (1/h) d/ds.
         let (r1, r2) = (1.0 / h, 1.0 / (h * h));
-        std::array::from_fn(|c| {
-            // The value basis enters as p0 + H5 (p1 - p0) (H0 = 1 - H5): written as
-            // H0 p0 + H5 p1 the derivatives would cancel two large terms (for a
-            // latitude of 0.8 rad at 100 Hz knots, 3e-4 m/s^2 of round-off in the
-            // acceleration).
-            let w = [
-                k1.value[c] - k0.value[c],
-                h * k0.rate[c],
-                h * h * k0.accel[c],
-                h * h * k1.accel[c],
-                h * k1.rate[c],
-            ];
-            let sum = |j: usize| {
-                w[0] * b[0][j] + w[1] * b[1][j] + w[2] * b[2][j] + w[3] * b[3][j] + w[4] * b[4][j]
-            };
-            [k0.value[c] + sum(0), sum(1) * r1, sum(2) * r2]
-        })
+        // Component by component in plain loops over arrays, so the six run two at a
+        // time on vector lanes.
+        let (mut v, mut d, mut dd) = ([0.0; 6], [0.0; 6], [0.0; 6]);
+        for c in 0..6 {
+            v[c] = k0.value[c] + Self::basis_sum(k0, k1, h, b0, c);
+            d[c] = Self::basis_sum(k0, k1, h, b1, c) * r1;
+            dd[c] = Self::basis_sum(k0, k1, h, b2, c) * r2;
+        }
+        std::array::from_fn(|c| [v[c], d[c], dd[c]])
     }
 
     /// All six components at time `t`, as jets ([`SplineTrajectory::derivatives`]
@@ -234,6 +273,27 @@ impl Trajectory for SplineTrajectory {
         t: f64,
     ) -> (crate::nav::NavState, super::analytic::Kinematics) {
         super::analytic::evaluate_geodetic(earth, t, &self.derivatives(t))
+    }
+
+    /// Roll, pitch and yaw as the spline holds them (unwrapped), values only: the same
+    /// bits as [`SplineTrajectory::derivatives`] gives.
+    fn euler_at(&self, t: f64) -> Option<crate::rotation::Euler> {
+        let (k0, k1, h, s) = self.locate(t);
+        let b = Self::value_basis(s);
+        let v = |c: usize| k0.value[c] + Self::basis_sum(k0, k1, h, b, c);
+        Some(crate::rotation::Euler::new(v(3), v(4), v(5)))
+    }
+
+    /// The interior knots in `(a, b)` (the first and last knot are no breaks: the end
+    /// pieces extend smoothly beyond them).
+    fn breaks(&self, a: f64, b: f64) -> &[f64] {
+        let times = &self.times;
+        let from = self.interval(a) + 1;
+        let mut to = from;
+        while to < times.len() - 1 && times[to] < b {
+            to += 1;
+        }
+        &times[from..to]
     }
 
     /// In closed form ([`super::analytic::kinematics_geodetic`]).
