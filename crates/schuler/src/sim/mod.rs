@@ -1,6 +1,7 @@
 //! Simulation: trajectories with exact truth and the IMU increments they produce.
 
 pub mod analytic;
+pub mod exact;
 pub mod gnss_ins_sim;
 pub mod imu_model;
 pub mod jet;

@@ -444,14 +444,14 @@ impl Run {
                     break;
                 }
                 let k0 = k * self.block;
-                exact_block(
+                super::exact::exact_block(
                     &earth,
                     &traj,
                     t0,
                     dt,
                     k0,
                     (k0 + self.block).min(n + 1),
-                    &mut block,
+                    &mut block.imu,
                 );
                 if sensors
                     .take(k, |s| s.measure(&earth, &traj, &mut block))
@@ -485,37 +485,6 @@ impl Run {
         }
         Ok(sensors.into_data().summary)
     }
-}
-
-/// The exact samples `k0..k1` (sample `k` ends at `t0 + k dt`) with the truth and
-/// kinematics at their ends, into `block.imu` (its memory reused from block to block;
-/// `measured` left for the sensors). Each sample is a pure function of its time, so
-/// blocks can be computed in any order and give the same bits.
-fn exact_block<E: EarthModel, T: Trajectory>(
-    earth: &E,
-    traj: &T,
-    t0: f64,
-    dt: f64,
-    k0: u64,
-    k1: u64,
-    block: &mut SimBlock,
-) {
-    let mut prev = analytic::kinematics(earth, traj, t0 + (k0 as f64 - 1.0) * dt);
-    block.imu.clear();
-    block.imu.extend((k0..k1).map(|k| {
-        let t = t0 + k as f64 * dt;
-        let (exact, truth, kin) = analytic::increment_from(earth, traj, t, dt, &prev);
-        prev = kin;
-        ImuEpoch {
-            exact,
-            measured: exact,
-            truth,
-            kin,
-            euler: traj
-                .euler_at(t)
-                .map_or_else(|| truth.euler(), |e| e.principal()),
-        }
-    }));
 }
 
 /// Call `f` for every epoch `t0 + j*interval <= t` not yet emitted.

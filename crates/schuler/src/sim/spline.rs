@@ -101,7 +101,7 @@ impl SplineTrajectory {
     /// guess and gallops outwards to a bracket before bisecting it: a few steps in
     /// place of a dozen scattered ones, for any spacing.
     #[inline]
-    fn interval(&self, t: f64) -> usize {
+    pub(crate) fn interval(&self, t: f64) -> usize {
         let times = &self.times;
         let last = times.len() - 2; // the last interval
         let (first_t, last_t) = (times[0], times[last + 1]);
@@ -135,10 +135,21 @@ impl SplineTrajectory {
         lo + times[lo + 1..hi.max(lo + 1)].partition_point(|&x| x <= t)
     }
 
+    /// The knot times.
+    pub(crate) fn times(&self) -> &[f64] {
+        &self.times
+    }
+
     /// The knots around `t`, their spacing `h` and `s = (t - t_0)/h` in [0, 1].
     #[inline]
     fn locate(&self, t: f64) -> (&Knot, &Knot, f64, f64) {
-        let i = self.interval(t);
+        self.locate_on(self.interval(t), t)
+    }
+
+    /// [`Self::locate`] on the piece from knot `i` to knot `i + 1` (`t` outside it
+    /// extends the piece's polynomial).
+    #[inline]
+    fn locate_on(&self, i: usize, t: f64) -> (&Knot, &Knot, f64, f64) {
         let (k0, k1) = (&self.knots[i], &self.knots[i + 1]);
         let h = k1.t - k0.t;
         (k0, k1, h, (t - k0.t) / h)
@@ -216,7 +227,14 @@ impl SplineTrajectory {
     /// All six components at time `t` with their first and second time derivatives,
     /// `[value, rate, acceleration]` each, from the basis derivatives in closed form.
     pub fn derivatives(&self, t: f64) -> [[f64; 3]; 6] {
-        let (k0, k1, h, s) = self.locate(t);
+        self.derivatives_on(self.interval(t), t)
+    }
+
+    /// [`Self::derivatives`] on the piece from knot `i` to knot `i + 1` (the same bits
+    /// when `i` is the piece holding `t`; any `i` when the caller knows it).
+    #[inline]
+    pub(crate) fn derivatives_on(&self, i: usize, t: f64) -> [[f64; 3]; 6] {
+        let (k0, k1, h, s) = self.locate_on(i, t);
         let b = Self::basis(s);
         let column = |j: usize| b.map(|f| f[j]);
         let (b0, b1, b2) = (column(0), column(1), column(2));
