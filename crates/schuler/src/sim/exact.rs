@@ -103,7 +103,9 @@ impl Antiderivative {
                 tail = tail.max(size(NODES - 2..NODES, i));
                 sum = sum.max(size(0..NODES, i));
             }
-            if !(tail <= TAIL * (sum + floor)) {
+            // A NaN anywhere fails too.
+            let accepted = tail <= TAIL * (sum + floor);
+            if !accepted {
                 return None;
             }
         }
