@@ -49,7 +49,7 @@
 //! height [m] within 100 m is a position row, and the file is refused at that line. A
 //! velocity would have to equal the vehicle's own coordinates to 1 mm/s in both
 //! horizontal axes; a position log is caught even from another receiver on the same
-//! vehicle (metres apart, 0.001° being 111 m). The rule applies to every text row
+//! vehicle (metres apart; 0.001° of latitude is 111 m). The rule applies to every text row
 //! matched to a fix, whatever its column count.
 //!
 //! # Barometer logs ([`read_baro`], `schuler nav --baro`)
