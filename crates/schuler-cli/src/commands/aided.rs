@@ -428,10 +428,15 @@ where
 #[derive(clap::Args, Debug, Default, Clone, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AidingOptions {
-    /// GNSS log (KF-GINS text: t lat lon h std_n std_e std_d [vn ve vd std...]).
+    /// GNSS position log: KF-GINS text (t lat lon h std_n std_e std_d [vn ve vd
+    /// std_vn std_ve std_vd], whose velocities are then used) or CSV whose header names
+    /// t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m (as `schuler simulate`'s gnss.csv;
+    /// its velocity columns are used only through --gnss-vel, its outlier flag never).
     #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub gnss: Option<PathBuf>,
-    /// GNSS velocity log (t vn ve vd [std_vn std_ve std_vd]) matched to the fixes by time.
+    /// GNSS velocity log matched to the fixes by time: text t vn ve vd [std_vn std_ve
+    /// std_vd] or CSV naming t,vn_mps,ve_mps,vd_mps[,std_vn_mps,...] (gnss.csv too); a
+    /// position log given here is an error.
     #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub gnss_vel: Option<PathBuf>,
     /// Velocity standard deviation where the velocity log gives none (default 0.1 m/s).

@@ -23,7 +23,8 @@ pub enum InputErrorKind {
     NoData,
     /// A line is longer than the reader's bound (see the reader's docs).
     LineTooLong,
-    /// The values look like the other layout (rates vs increments) than the one read.
+    /// The values look like another layout than the one read: rates where increments
+    /// are expected, or a GNSS position log given as a velocity log.
     LayoutMismatch,
     /// A reader option (nominal interval, time window) is invalid, or the file holds
     /// too little data to establish what the reader needs.

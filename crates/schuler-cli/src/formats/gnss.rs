@@ -1,7 +1,59 @@
-//! GNSS logs in the KF-GINS text format: `t lat lon h std_n std_e std_d` (degrees,
-//! metres), optionally followed by `vn ve vd std_vn std_ve std_vd`; and velocity logs
-//! `t vn ve vd [std_vn std_ve std_vd]` (as gnss-ins-sim writes beside them). GNSS logs
-//! are small (one line per fix), so they are read whole.
+//! GNSS and barometer logs: small files (one line per fix or reading), read whole.
+//! Blank lines and `#`/`%` comments are skipped everywhere, line numbers in errors count
+//! every line of the file (1-based), and every problem is an [`InputError`] naming the
+//! file, the line and the field.
+//!
+//! # Position logs ([`read_gnss`], `schuler nav --gnss`)
+//! The first data line tells the format: a header if its first field is not a number.
+//! - **KF-GINS text**: `t lat lon h std_n std_e std_d` [s, deg, deg, m, m, m, m], 7
+//!   columns, or 13 with `vn ve vd std_vn std_ve std_vd` [m/s] after them; blanks or
+//!   commas between fields. The 13-column layout is a receiver's position *and*
+//!   velocity, and its velocities are used as velocity aiding.
+//! - **CSV with a header**, as `schuler simulate` writes `gnss.csv`: comma-separated,
+//!   every data line with as many fields as the header, columns found by name (ASCII
+//!   case-insensitive, blanks and double quotes around a name ignored) in any order.
+//!   Required: `t` (or `time`), `lat_deg`, `lon_deg`, `h_m`, `std_n_m`, `std_e_m`,
+//!   `std_d_m`; a missing one is an error naming it and the header's line. Other
+//!   columns are ignored and not parsed, with two named on purpose:
+//!   - `outlier` (0 or 1) is checked and kept in [`GnssRecord::outlier`] but never
+//!     drops a fix: it is the simulator's *truth* (1 where it injected a jump), not a
+//!     receiver's quality flag, and a navigator that dropped flagged fixes would be
+//!     handed the answer it is tested on; the filter's gate has to find them.
+//!   - the velocity columns (`vn_mps ve_mps vd_mps std_vn_mps std_ve_mps std_vd_mps`)
+//!     are not read as velocity aiding here: the simulator writes them whether or not
+//!     the scenario measures velocity (standard deviations 0, exact velocities, when it
+//!     sets no `gnss.velocity_std`), so a CSV's velocities are used only when the file
+//!     is also named as the velocity log (`--gnss-vel gnss.csv`, [`merge_velocity`]).
+//!
+//!   So `gnss.csv` gives the same fixes as `gnss.txt` (the simulator writes the same
+//!   numbers in both), and the same navigation.
+//!
+//! # Velocity logs ([`merge_velocity`], `schuler nav --gnss-vel`)
+//! - **Text**: `t vn ve vd [std_vn std_ve std_vd]` [s, m/s], 4 or 7 columns (as
+//!   gnss-ins-sim writes beside its positions).
+//! - **CSV with a header**: `t` (or `time`), `vn_mps`, `ve_mps`, `vd_mps` required;
+//!   `std_vn_mps`, `std_ve_mps`, `std_vd_mps` all three or none; other columns ignored
+//!   (so the simulator's `gnss.csv` is a velocity log too).
+//!
+//! A position log given as a velocity log is refused, never read as velocities. The
+//! structure decides where it can:
+//! - a CSV header must name the velocity columns (the error says so when it names a
+//!   position log's `lat_deg`, `lon_deg`, `h_m` instead);
+//! - 13 text columns are the position-and-velocity layout; a velocity log has 4 or 7.
+//!
+//! Seven text columns are also the shape of a 7-column position log (`t lat lon h std_n
+//! std_e std_d`), which no count or range can tell apart (latitudes and longitudes in
+//! degrees are plausible speeds in m/s), so there the values decide against the
+//! position fixes the velocities are matched to: a text row whose `vn ve vd` repeat
+//! the latitude and longitude [deg] of the fix at the same time within 0.001° and its
+//! height [m] within 100 m is a position row, and the file is refused at that line. A
+//! velocity would have to equal the vehicle's own coordinates to 1 mm/s in both
+//! horizontal axes; a position log is caught even from another receiver on the same
+//! vehicle (metres apart; 0.001° of latitude is 111 m). The rule applies to every text row
+//! matched to a fix, whatever its column count.
+//!
+//! # Barometer logs ([`read_baro`], `schuler nav --baro`)
+//! `baro.csv` as `schuler simulate` writes it (`t,h_m,outlier`) or headerless `t h`.
 
 use super::error::{InputError, InputErrorKind};
 use nalgebra::Vector3;
@@ -15,6 +67,131 @@ const POS_FIELDS: [&str; 13] = [
 ];
 const VEL_FIELDS: [&str; 7] = ["time", "vn", "ve", "vd", "std_vn", "std_ve", "std_vd"];
 
+/// The columns a position CSV must name (the time first).
+const CSV_POS: [&str; 7] = [
+    "t", "lat_deg", "lon_deg", "h_m", "std_n_m", "std_e_m", "std_d_m",
+];
+/// The columns a velocity CSV must name (the time first).
+const CSV_VEL: [&str; 4] = ["t", "vn_mps", "ve_mps", "vd_mps"];
+/// The velocity standard deviations a velocity CSV may name, all three or none.
+const CSV_VEL_STD: [&str; 3] = ["std_vn_mps", "std_ve_mps", "std_vd_mps"];
+/// The simulator's truth flag in a position CSV (see the module doc).
+const CSV_OUTLIER: &str = "outlier";
+
+/// A velocity text row repeating the matched fix's latitude and longitude within this
+/// [deg] ...
+const SAME_ANGLE_DEG: f64 = 1e-3;
+/// ... and its height within this [m] is a position row (see the module doc).
+const SAME_HEIGHT_M: f64 = 100.0;
+
+/// Numbers of data lines, each with its 1-based line number.
+type Rows = Vec<(u64, Vec<f64>)>;
+
+/// The whole text of a small log (a leading UTF-8 byte-order mark dropped).
+fn read_text(path: &Path) -> Result<String, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        InputError::new(
+            InputErrorKind::Io,
+            path,
+            0,
+            None,
+            format!("cannot read: {e}"),
+        )
+    })?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_owned(),
+        None => text,
+    })
+}
+
+/// The lines that may carry data, trimmed, with their 1-based numbers: blank lines and
+/// `#`/`%` comments skipped.
+fn content_lines(text: &str) -> impl Iterator<Item = (u64, &str)> {
+    text.lines().enumerate().filter_map(|(i, line)| {
+        let l = line.trim();
+        let skip = l.is_empty() || l.starts_with('#') || l.starts_with('%');
+        (!skip).then_some((i as u64 + 1, l))
+    })
+}
+
+/// The fields of a text line: separated by blanks or commas.
+fn text_fields(l: &str) -> Vec<&str> {
+    l.split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|f| !f.is_empty())
+        .collect()
+}
+
+/// Whether the first data line is a CSV header: its first field is not a number.
+fn is_header(l: &str) -> bool {
+    text_fields(l)
+        .first()
+        .is_some_and(|f| f.parse::<f64>().is_err())
+}
+
+/// Field `name` of line `n` parsed from `text`: a finite number, and positive if `name`
+/// is a standard deviation (starts with `std`; `std_hint` is then added to the error).
+fn parse_field(
+    path: &Path,
+    n: u64,
+    name: &str,
+    text: &str,
+    std_hint: &str,
+) -> Result<f64, InputError> {
+    let x: f64 = text.parse().map_err(|_| {
+        InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            n,
+            Some(name),
+            format!("not a number: {text:?}"),
+        )
+    })?;
+    if !x.is_finite() {
+        return Err(InputError::new(
+            InputErrorKind::NotFinite,
+            path,
+            n,
+            Some(name),
+            format!("not finite: {text:?}"),
+        ));
+    }
+    if name.starts_with("std") && x <= 0.0 {
+        return Err(InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            n,
+            Some(name),
+            format!("a standard deviation must be positive, got {text}{std_hint}"),
+        ));
+    }
+    Ok(x)
+}
+
+/// Checks that time `t` of line `n` (field `name`) comes after the previous row's.
+fn check_time(
+    path: &Path,
+    n: u64,
+    name: &str,
+    t: f64,
+    prev: Option<&(u64, Vec<f64>)>,
+) -> Result<(), InputError> {
+    match prev {
+        Some((_, p)) if t <= p[0] => Err(InputError::new(
+            InputErrorKind::TimeNotIncreasing,
+            path,
+            n,
+            Some(name),
+            format!("time {t} does not increase (previous {})", p[0]),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The error of a file without a data line.
+fn no_data(path: &Path) -> InputError {
+    InputError::new(InputErrorKind::NoData, path, 0, None, "no data line")
+}
+
 /// Numbers of each data line (blank lines and `#`/`%` comments skipped, and with
 /// `header` a first line that starts with a letter), with their 1-based line numbers;
 /// checks column counts (one of `counts`), finiteness, positive standard deviations
@@ -25,111 +202,257 @@ pub(crate) fn numeric_rows(
     names: &[&str],
     counts: &[usize],
     header: bool,
-) -> Result<Vec<(u64, Vec<f64>)>, InputError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        InputError::new(
-            InputErrorKind::Io,
-            path,
-            0,
-            None,
-            format!("cannot read: {e}"),
-        )
-    })?;
-    let mut rows: Vec<(u64, Vec<f64>)> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let n = i as u64 + 1;
-        let l = line.trim();
-        if l.is_empty()
-            || l.starts_with('#')
-            || l.starts_with('%')
-            || (header && n == 1 && l.starts_with(|c: char| c.is_ascii_alphabetic()))
-        {
-            continue;
-        }
-        let fields: Vec<&str> = l
-            .split(|c: char| c.is_whitespace() || c == ',')
-            .filter(|f| !f.is_empty())
-            .collect();
+) -> Result<Rows, InputError> {
+    let text = read_text(path)?;
+    let lines = content_lines(&text)
+        .filter(|&(n, l)| !(header && n == 1 && l.starts_with(|c: char| c.is_ascii_alphabetic())));
+    text_rows(path, lines, names, counts, &|k| {
+        format!("{k} columns, expected {counts:?}")
+    })
+}
+
+/// [`numeric_rows`] on given lines; `wrong_count(k)` is the message for a line of `k`
+/// columns, `k` not in `counts`.
+fn text_rows<'a>(
+    path: &Path,
+    lines: impl Iterator<Item = (u64, &'a str)>,
+    names: &[&str],
+    counts: &[usize],
+    wrong_count: &dyn Fn(usize) -> String,
+) -> Result<Rows, InputError> {
+    let mut rows: Rows = Vec::new();
+    for (n, l) in lines {
+        let fields = text_fields(l);
         if !counts.contains(&fields.len()) {
             return Err(InputError::new(
                 InputErrorKind::ColumnCount,
                 path,
                 n,
                 None,
-                format!("{} columns, expected {counts:?}", fields.len()),
+                wrong_count(fields.len()),
             ));
         }
-        let mut v = Vec::with_capacity(fields.len());
-        for (k, f) in fields.iter().enumerate() {
-            let x: f64 = f.parse().map_err(|_| {
-                InputError::new(
-                    InputErrorKind::NotANumber,
-                    path,
-                    n,
-                    Some(names[k]),
-                    format!("not a number: {f:?}"),
-                )
-            })?;
-            if !x.is_finite() {
-                return Err(InputError::new(
-                    InputErrorKind::NotFinite,
-                    path,
-                    n,
-                    Some(names[k]),
-                    format!("not finite: {f:?}"),
-                ));
-            }
-            if names[k].starts_with("std") && x <= 0.0 {
-                return Err(InputError::new(
-                    InputErrorKind::NotANumber,
-                    path,
-                    n,
-                    Some(names[k]),
-                    format!("a standard deviation must be positive, got {f}"),
-                ));
-            }
-            v.push(x);
-        }
-        if let Some((_, prev)) = rows.last()
-            && v[0] <= prev[0]
-        {
-            return Err(InputError::new(
-                InputErrorKind::TimeNotIncreasing,
-                path,
-                n,
-                Some("time"),
-                format!("time {} does not increase (previous {})", v[0], prev[0]),
-            ));
-        }
+        let v = fields
+            .iter()
+            .zip(names)
+            .map(|(f, name)| parse_field(path, n, name, f, ""))
+            .collect::<Result<Vec<f64>, _>>()?;
+        check_time(path, n, names[0], v[0], rows.last())?;
         rows.push((n, v));
     }
     if rows.is_empty() {
-        return Err(InputError::new(
-            InputErrorKind::NoData,
-            path,
-            0,
-            None,
-            "no data line",
-        ));
+        return Err(no_data(path));
     }
     Ok(rows)
 }
 
-/// Read a GNSS position log (7 or 13 columns).
-pub fn read_gnss(path: &Path) -> Result<Vec<GnssFix>, InputError> {
-    let rows = numeric_rows(path, &POS_FIELDS, &[7, 13], false)?;
-    let mut fixes = Vec::with_capacity(rows.len());
-    for (n, v) in rows {
+/// A CSV log's header line: the column names as written, each trimmed of blanks and
+/// double quotes.
+struct CsvHeader<'a> {
+    path: &'a Path,
+    /// 1-based line number of the header.
+    line: u64,
+    names: Vec<String>,
+}
+
+impl<'a> CsvHeader<'a> {
+    /// The header in line `line` (text `l`) of `path`.
+    fn parse(path: &'a Path, line: u64, l: &str) -> Self {
+        let names = l
+            .split(',')
+            .map(|raw| {
+                let name = raw.trim();
+                let name = name
+                    .strip_prefix('"')
+                    .and_then(|s| s.strip_suffix('"'))
+                    .unwrap_or(name);
+                name.trim().to_owned()
+            })
+            .collect();
+        Self { path, line, names }
+    }
+
+    /// A header error with `message`.
+    fn error(&self, field: Option<&str>, message: String) -> InputError {
+        InputError::new(InputErrorKind::Header, self.path, self.line, field, message)
+    }
+
+    /// The column named `name` (ASCII case-insensitive; `t` also as `time`), if any; a
+    /// name given twice is an error.
+    fn find(&self, name: &str) -> Result<Option<usize>, InputError> {
+        let aliases: &[&str] = if name == "t" { &["t", "time"] } else { &[name] };
+        let found: Vec<usize> = (0..self.names.len())
+            .filter(|&i| {
+                aliases
+                    .iter()
+                    .any(|a| self.names[i].eq_ignore_ascii_case(a))
+            })
+            .collect();
+        match found[..] {
+            [] => Ok(None),
+            [col] => Ok(Some(col)),
+            [a, b, ..] => Err(self.error(
+                Some(name),
+                format!("column appears twice (columns {} and {})", a + 1, b + 1),
+            )),
+        }
+    }
+
+    /// Where each of `names` is, or an error naming every missing one; `what` says what
+    /// needs them, `hint` is added to the error.
+    fn require(&self, names: &[&str], what: &str, hint: &str) -> Result<Vec<usize>, InputError> {
+        let mut cols = Vec::with_capacity(names.len());
+        let mut missing = Vec::new();
+        for &name in names {
+            match self.find(name)? {
+                Some(c) => cols.push(c),
+                None => missing.push(name),
+            }
+        }
+        if missing.is_empty() {
+            return Ok(cols);
+        }
+        let taken = if missing.len() == names.len() {
+            format!(
+                "; line {} was taken for a CSV header because its first field is not a \
+                 number (a header names comma-separated columns)",
+                self.line
+            )
+        } else {
+            String::new()
+        };
+        Err(self.error(
+            (missing.len() == 1).then_some(missing[0]),
+            format!(
+                "the header lacks column{} {} ({what} needs {}; other columns are ignored){hint}{taken}",
+                if missing.len() == 1 { "" } else { "s" },
+                missing.join(", "),
+                names.join(", "),
+            ),
+        ))
+    }
+
+    /// Rows of numbers after the header: each line comma-separated with as many fields
+    /// as the header names, the columns `cols` (index, name for errors) parsed in their
+    /// order (checked as [`parse_field`] does, `std_hint` added to a standard deviation's
+    /// error), the first one the time, which must increase.
+    fn rows<'l>(
+        &self,
+        lines: impl Iterator<Item = (u64, &'l str)>,
+        cols: &[(usize, &str)],
+        std_hint: &str,
+    ) -> Result<Rows, InputError> {
+        let mut rows: Rows = Vec::new();
+        for (n, l) in lines {
+            let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+            if fields.len() != self.names.len() {
+                return Err(InputError::new(
+                    InputErrorKind::ColumnCount,
+                    self.path,
+                    n,
+                    None,
+                    format!(
+                        "{} columns, the header (line {}) names {}",
+                        fields.len(),
+                        self.line,
+                        self.names.len()
+                    ),
+                ));
+            }
+            let v = cols
+                .iter()
+                .map(|&(c, name)| parse_field(self.path, n, name, fields[c], std_hint))
+                .collect::<Result<Vec<f64>, _>>()?;
+            check_time(self.path, n, cols[0].1, v[0], rows.last())?;
+            rows.push((n, v));
+        }
+        if rows.is_empty() {
+            return Err(no_data(self.path));
+        }
+        Ok(rows)
+    }
+}
+
+/// One fix of a GNSS position log, with its line and what the filter does not use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GnssRecord {
+    /// 1-based line number in the file.
+    pub line: u64,
+    /// The fix.
+    pub fix: GnssFix,
+    /// A CSV's `outlier` column: the simulator's truth flag, never used to drop the fix
+    /// (see the module doc); `None` where the file has no such column.
+    pub outlier: Option<bool>,
+}
+
+/// Read a GNSS position log (KF-GINS text, 7 or 13 columns, or CSV with a header; see
+/// the module doc) with each fix's line and outlier flag.
+pub fn read_gnss_records(path: &Path) -> Result<Vec<GnssRecord>, InputError> {
+    let text = read_text(path)?;
+    let mut lines = content_lines(&text).peekable();
+    let header = match lines.peek() {
+        Some(&(n, l)) if is_header(l) => {
+            lines.next();
+            Some(CsvHeader::parse(path, n, l))
+        }
+        _ => None,
+    };
+    // Rows as `t lat lon h std_n std_e std_d [vn ve vd std_vn std_ve std_vd]`, and the
+    // outlier flag.
+    let (rows, lat_name) = match &header {
+        None => {
+            let rows = text_rows(path, lines, &POS_FIELDS, &[7, 13], &|k| {
+                format!("{k} columns, expected [7, 13]")
+            })?;
+            (
+                rows.into_iter()
+                    .map(|(n, v)| (n, v, None))
+                    .collect::<Vec<_>>(),
+                "lat",
+            )
+        }
+        Some(h) => {
+            let mut cols: Vec<(usize, &str)> = h
+                .require(&CSV_POS, "a GNSS position log", "")?
+                .into_iter()
+                .zip(CSV_POS)
+                .collect();
+            let outlier = h.find(CSV_OUTLIER)?;
+            if let Some(c) = outlier {
+                cols.push((c, CSV_OUTLIER));
+            }
+            let mut out = Vec::new();
+            for (n, mut v) in h.rows(lines, &cols, "")? {
+                let flag = match outlier.and_then(|_| v.pop()) {
+                    None => None,
+                    Some(x) if x == 0.0 || x == 1.0 => Some(x == 1.0),
+                    Some(x) => {
+                        return Err(InputError::new(
+                            InputErrorKind::NotANumber,
+                            path,
+                            n,
+                            Some(CSV_OUTLIER),
+                            format!("the outlier flag is 0 or 1, got {x}"),
+                        ));
+                    }
+                };
+                out.push((n, v, flag));
+            }
+            (out, "lat_deg")
+        }
+    };
+    let mut records = Vec::with_capacity(rows.len());
+    for (n, v, outlier) in rows {
         if !(-90.0..=90.0).contains(&v[1]) {
             return Err(InputError::new(
                 InputErrorKind::NotANumber,
                 path,
                 n,
-                Some("lat"),
+                Some(lat_name),
                 format!("latitude {} is outside [-90, 90]", v[1]),
             ));
         }
-        fixes.push(GnssFix {
+        let fix = GnssFix {
             t: v[0],
             pos: Geodetic::from_degrees(v[1], v[2], v[3]),
             pos_std: Vector3::new(v[4], v[5], v[6]),
@@ -139,27 +462,121 @@ pub fn read_gnss(path: &Path) -> Result<Vec<GnssFix>, InputError> {
                     Vector3::new(v[10], v[11], v[12]),
                 )
             }),
+        };
+        records.push(GnssRecord {
+            line: n,
+            fix,
+            outlier,
         });
     }
-    Ok(fixes)
+    Ok(records)
 }
 
-/// Add the velocities of a velocity log (4 or 7 columns; `default_std` [m/s] where the
-/// file gives none) to the fixes at the same times (within 1 µs). Returns the number
-/// of velocity epochs without a position fix (not used).
+/// Read a GNSS position log (KF-GINS text, 7 or 13 columns, or CSV with a header; see
+/// the module doc): the fixes in time order, with velocity where the 13-column layout
+/// gives it.
+pub fn read_gnss(path: &Path) -> Result<Vec<GnssFix>, InputError> {
+    Ok(read_gnss_records(path)?
+        .into_iter()
+        .map(|r| r.fix)
+        .collect())
+}
+
+/// A velocity log's rows as `t vn ve vd [std_vn std_ve std_vd]`, and whether the file
+/// is headerless text (whose rows [`merge_velocity`] checks against the fixes).
+fn read_velocity(path: &Path) -> Result<(Rows, bool), InputError> {
+    let text = read_text(path)?;
+    let mut lines = content_lines(&text).peekable();
+    let header = match lines.peek() {
+        Some(&(n, l)) if is_header(l) => {
+            lines.next();
+            CsvHeader::parse(path, n, l)
+        }
+        _ => {
+            let rows = text_rows(path, lines, &VEL_FIELDS, &[4, 7], &|k| {
+                if k == 13 {
+                    "13 columns: the layout of a GNSS position log with velocity (t lat lon h \
+                     std_n std_e std_d vn ve vd std_vn std_ve std_vd), not of a velocity log \
+                     (t vn ve vd [std_vn std_ve std_vd], 4 or 7 columns); give it as the \
+                     position log, whose velocity columns are then used"
+                        .to_owned()
+                } else {
+                    format!("{k} columns, expected [4, 7]")
+                }
+            })?;
+            return Ok((rows, true));
+        }
+    };
+    let position = ["lat_deg", "lon_deg", "h_m"]
+        .iter()
+        .filter_map(|name| header.find(name).ok().flatten())
+        .count()
+        > 0;
+    let hint = if position {
+        "; it names a position log's lat_deg, lon_deg or h_m: this is a GNSS position log, \
+         not a velocity log"
+    } else {
+        ""
+    };
+    let mut cols: Vec<(usize, &str)> = header
+        .require(&CSV_VEL, "a GNSS velocity log", hint)?
+        .into_iter()
+        .zip(CSV_VEL)
+        .collect();
+    let mut std_cols = Vec::new();
+    let mut std_missing = Vec::new();
+    for name in CSV_VEL_STD {
+        match header.find(name)? {
+            Some(c) => std_cols.push((c, name)),
+            None => std_missing.push(name),
+        }
+    }
+    if !std_cols.is_empty() && !std_missing.is_empty() {
+        return Err(header.error(
+            Some(std_missing[0]),
+            format!(
+                "the header names {} but not {}: a velocity log gives its standard \
+                 deviations all three or none",
+                std_cols
+                    .iter()
+                    .map(|(_, name)| *name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                std_missing.join(", ")
+            ),
+        ));
+    }
+    cols.extend(std_cols);
+    let rows = header.rows(
+        lines,
+        &cols,
+        " (schuler simulate writes 0, exact velocities, when the scenario sets no \
+         gnss.velocity_std)",
+    )?;
+    Ok((rows, false))
+}
+
+/// Add the velocities of a velocity log (text of 4 or 7 columns or CSV with a header,
+/// see the module doc; `default_std` [m/s] where the file gives none) to the fixes at
+/// the same times (within 1 µs). Returns the number of velocity epochs without a
+/// position fix (not used). A text row that repeats its fix's latitude, longitude and
+/// height is a position row and an error (the module doc gives the rule).
 pub fn merge_velocity(
     fixes: &mut [GnssFix],
     path: &Path,
     default_std: f64,
 ) -> Result<usize, InputError> {
-    let rows = numeric_rows(path, &VEL_FIELDS, &[4, 7], false)?;
+    let (rows, text) = read_velocity(path)?;
     let mut unmatched = 0;
     let mut j = 0;
-    for (_, v) in rows {
+    for (n, v) in rows {
         while j < fixes.len() && fixes[j].t < v[0] - 1e-6 {
             j += 1;
         }
         if j < fixes.len() && (fixes[j].t - v[0]).abs() <= 1e-6 {
+            if text {
+                check_not_position(path, n, &v, &fixes[j])?;
+            }
             let std = if v.len() == 7 {
                 Vector3::new(v[4], v[5], v[6])
             } else {
@@ -171,6 +588,37 @@ pub fn merge_velocity(
         }
     }
     Ok(unmatched)
+}
+
+/// The module doc's rule: a velocity text row `v` (line `n`) whose `vn ve vd` repeat
+/// the latitude and longitude [deg] of `fix` within [`SAME_ANGLE_DEG`] and its height
+/// within [`SAME_HEIGHT_M`] is a position row.
+fn check_not_position(path: &Path, n: u64, v: &[f64], fix: &GnssFix) -> Result<(), InputError> {
+    let (lat, lon, h) = (
+        fix.pos.lat.to_degrees(),
+        fix.pos.lon.to_degrees(),
+        fix.pos.h,
+    );
+    let d_lon = (v[2] - lon + 180.0).rem_euclid(360.0) - 180.0;
+    if (v[1] - lat).abs() <= SAME_ANGLE_DEG
+        && d_lon.abs() <= SAME_ANGLE_DEG
+        && (v[3] - h).abs() <= SAME_HEIGHT_M
+    {
+        return Err(InputError::new(
+            InputErrorKind::LayoutMismatch,
+            path,
+            n,
+            None,
+            format!(
+                "vn ve vd = {} {} {} repeat the latitude, longitude [deg] and height [m] of \
+                 the position fix at t = {} ({lat:.9} {lon:.9} {h:.3}): this is a GNSS \
+                 position log (t lat lon h std_n std_e std_d), not a velocity log (t vn ve \
+                 vd [std_vn std_ve std_vd])",
+                v[1], v[2], v[3], fix.t
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Read a barometer log: `baro.csv` as `schuler simulate` writes it (header
@@ -270,6 +718,197 @@ mod tests {
             1
         );
         assert_eq!(fixes[0].vel.map(|(v, s)| (v.x, s.x)), Some((4.0, 0.05)));
+    }
+
+    /// The simulator's header, written by `schuler simulate` (commands/simulate.rs).
+    const SIM_HEADER: &str = "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier";
+
+    #[test]
+    fn reads_the_simulators_csv_by_its_header_as_the_text_twin() {
+        // Velocity stds 0 (a scenario without gnss.velocity_std): not read as positions.
+        let csv = file(&format!(
+            "{SIM_HEADER}\n1,45.5,7.25,100.125,0.5,0.5,1,1.5,-2,0.25,0,0,0,0\n\
+             2,45.50001,7.25001,100.5,0.5,0.5,1,1.5,-2,0.25,0,0,0,1\n"
+        ));
+        let txt = file("1 45.5 7.25 100.125 0.5 0.5 1\n2 45.50001 7.25001 100.5 0.5 0.5 1\n");
+        let records = read_gnss_records(csv.path()).expect("reads the CSV");
+        assert_eq!(
+            records.iter().map(|r| r.fix).collect::<Vec<_>>(),
+            read_gnss(txt.path()).expect("reads the text")
+        );
+        assert!(records.iter().all(|r| r.fix.vel.is_none()));
+        assert_eq!(
+            records
+                .iter()
+                .map(|r| (r.line, r.outlier))
+                .collect::<Vec<_>>(),
+            vec![(2, Some(false)), (3, Some(true))]
+        );
+        // Order free, names case-insensitive and quoted, `time` for `t`, other columns
+        // ignored and not parsed, comments before the header.
+        let csv = file(
+            "# from elsewhere\n\"LON_DEG\", lat_deg ,h_m,std_n_m,std_e_m,std_d_m,time,note\n\
+             7.25,45.5,100.125,0.5,0.5,1,1,abc\n",
+        );
+        let records = read_gnss_records(csv.path()).expect("reads");
+        assert_eq!(records[0].fix, read_gnss(txt.path()).expect("reads")[0]);
+        assert_eq!((records[0].line, records[0].outlier), (3, None));
+    }
+
+    #[test]
+    fn a_csv_header_error_names_the_line_and_the_column() {
+        let cases = [
+            (
+                "t,lat_deg,lon_deg,std_n_m,std_e_m,std_d_m\n1,45,7,1,1,1\n",
+                ":1: field h_m: the header lacks column h_m (a GNSS position log needs t, \
+                 lat_deg, lon_deg, h_m, std_n_m, std_e_m, std_d_m",
+            ),
+            (
+                "# c\nt,lat,lon,h_m,std_n_m,std_e_m,std_d_m\n",
+                ":2: the header lacks columns lat_deg, lon_deg (",
+            ),
+            (
+                "t lat lon h std_n std_e std_d\n",
+                "was taken for a CSV header because its first field is not a number",
+            ),
+            (
+                "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,time\n",
+                ":1: field t: column appears twice (columns 1 and 8)",
+            ),
+            (
+                &format!("{SIM_HEADER}\n1,45,7,100,1,1,1,0,0,0,0,0,0\n"),
+                ":2: 13 columns, the header (line 1) names 14",
+            ),
+            (
+                &format!("{SIM_HEADER}\n1,45,7,100,1,1,1,0,0,0,0,0,0,2\n"),
+                ":2: field outlier: the outlier flag is 0 or 1, got 2",
+            ),
+            (
+                &format!("{SIM_HEADER}\n1,45,7,,1,1,1,0,0,0,0,0,0,0\n"),
+                ":2: field h_m: not a number: \"\"",
+            ),
+            (
+                &format!("{SIM_HEADER}\n1,95,7,1,1,1,1,0,0,0,0,0,0,0\n"),
+                ":2: field lat_deg: latitude 95 is outside",
+            ),
+            (
+                &format!(
+                    "{SIM_HEADER}\n2,45,7,1,1,1,1,0,0,0,0,0,0,0\n1,45,7,1,1,1,1,0,0,0,0,0,0,0\n"
+                ),
+                ":3: field t: time 1 does not increase",
+            ),
+            (&format!("{SIM_HEADER}\n"), "no data line"),
+        ];
+        for (text, want) in cases {
+            let f = file(text);
+            let e = read_gnss(f.path()).expect_err(text);
+            let shown = e.to_string();
+            assert!(
+                shown.starts_with(&f.path().display().to_string()) && shown.contains(want),
+                "{text:?}: {shown}"
+            );
+        }
+    }
+
+    #[test]
+    fn velocity_logs_by_header_and_text() {
+        let pos = "1 45.5 7.25 100 0.5 0.5 1\n2 45.50001 7.25001 100 0.5 0.5 1\n";
+        // The simulator's CSV as a velocity log: its velocity columns by name.
+        let mut fixes = read_gnss(file(pos).path()).expect("reads");
+        let csv = file(&format!(
+            "{SIM_HEADER}\n1,45.5,7.25,100,0.5,0.5,1,1.5,-2,0.25,0.05,0.05,0.1,0\n"
+        ));
+        assert_eq!(
+            merge_velocity(&mut fixes, csv.path(), 0.3).expect("merge"),
+            0
+        );
+        assert_eq!(
+            fixes[0].vel,
+            Some((Vector3::new(1.5, -2.0, 0.25), Vector3::new(0.05, 0.05, 0.1)))
+        );
+        assert!(fixes[1].vel.is_none());
+        // Without standard deviations: the default.
+        let csv = file("vd_mps,ve_mps,vn_mps,t\n0.25,-2,1.5,2\n");
+        assert_eq!(
+            merge_velocity(&mut fixes, csv.path(), 0.3).expect("merge"),
+            0
+        );
+        assert_eq!(
+            fixes[1].vel,
+            Some((Vector3::new(1.5, -2.0, 0.25), Vector3::repeat(0.3)))
+        );
+        // A 7-column text velocity log is still one.
+        let txt = file("1 30.5 114.3 -0.5 0.05 0.05 0.1\n2 0 0 0 0.05 0.05 0.1\n");
+        assert_eq!(
+            merge_velocity(&mut fixes, txt.path(), 0.3).expect("merge"),
+            0
+        );
+        assert_eq!(fixes[0].vel.map(|(v, _)| v.y), Some(114.3));
+    }
+
+    #[test]
+    fn a_position_log_is_never_read_as_velocities() {
+        let pos = "# fixes\n1 45.5 7.25 100 0.5 0.5 1\n2 45.50001 7.25001 100.5 0.5 0.5 1\n";
+        let cases = [
+            // The position log itself (7 columns): line 2 is its first fix.
+            (
+                pos.to_owned(),
+                ":2: vn ve vd = 45.5 7.25 100 repeat the latitude, longitude [deg] and height \
+                 [m] of the position fix at t = 1",
+            ),
+            // Another receiver's positions, metres away, only from the second fix on.
+            (
+                "1 0 0 0\n2 45.50003 7.24998 98 0.5 0.5 1\n".to_owned(),
+                ":2: vn ve vd = 45.50003 7.24998 98 repeat",
+            ),
+            // Longitude across the antimeridian's numbers.
+            (
+                "1 45.5 367.25 100\n".to_owned(),
+                ":1: vn ve vd = 45.5 367.25 100 repeat",
+            ),
+            (
+                "1 45.5 7.25 100 0.5 0.5 1 0 0 0 0.1 0.1 0.1\n".to_owned(),
+                ":1: 13 columns: the layout of a GNSS position log with velocity",
+            ),
+            (
+                "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m\n1,45.5,7.25,100,0.5,0.5,1\n"
+                    .to_owned(),
+                ":1: the header lacks columns vn_mps, ve_mps, vd_mps (a GNSS velocity log \
+                 needs t, vn_mps, ve_mps, vd_mps; other columns are ignored); it names a \
+                 position log's lat_deg",
+            ),
+            (
+                format!("{SIM_HEADER}\n1,45.5,7.25,100,0.5,0.5,1,1.5,-2,0.25,0,0,0,0\n"),
+                ":2: field std_vn_mps: a standard deviation must be positive, got 0 (schuler \
+                 simulate writes 0",
+            ),
+            (
+                "t,vn_mps,ve_mps,vd_mps,std_vn_mps\n1,0,0,0,0.1\n".to_owned(),
+                ":1: field std_ve_mps: the header names std_vn_mps but not std_ve_mps, \
+                 std_vd_mps",
+            ),
+        ];
+        for (text, want) in cases {
+            let mut fixes = read_gnss(file(pos).path()).expect("reads");
+            let f = file(&text);
+            let e = merge_velocity(&mut fixes, f.path(), 0.1).expect_err(&text);
+            let shown = e.to_string();
+            assert!(
+                shown.starts_with(&f.path().display().to_string()) && shown.contains(want),
+                "{text:?}: {shown}"
+            );
+        }
+        let mut fixes = read_gnss(file(pos).path()).expect("reads");
+        let e = merge_velocity(&mut fixes, file(pos).path(), 0.1).expect_err("position");
+        assert_eq!(e.kind, InputErrorKind::LayoutMismatch);
+        // A real velocity log at the same numbers in another unit would need a speed
+        // of 45 m/s north, 7 m/s east and 100 m/s down: a fast dive, but not the fix's
+        // own coordinates to 0.001, so it is read.
+        let v = file("1 45.6 7.25 100\n");
+        assert_eq!(
+            merge_velocity(&mut fixes, v.path(), 0.1).expect("a velocity"),
+            0
+        );
     }
 
     #[test]
