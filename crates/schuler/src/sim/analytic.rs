@@ -199,8 +199,8 @@ struct GeodeticExtras {
 }
 
 /// Kinematics in closed form from geodetic position and Euler angles with their
-/// derivatives; no jets, no ECEF round trip, one `sin_cos` per angle (latitude and
-/// the three Euler angles; longitude enters only through its rates).
+/// derivatives and the sines and cosines of latitude and the three Euler angles
+/// (longitude enters only through its rates); no jets, no ECEF round trip.
 ///
 /// Angular rate: `w_ib_b = w_nb_b + C_nb (w_ie_n + w_en_n)` with the exact kinematic
 /// transport rate `w_en_n = [lon' cos lat, −lat', −lon' sin lat]`, `w_ie_n =
@@ -220,9 +220,11 @@ struct GeodeticExtras {
 fn geodetic_kinematics<E: EarthModel>(
     earth: &E,
     c: &GeodeticEuler,
+    trig: &Trig,
 ) -> (Kinematics, GeodeticExtras) {
-    let [lat, lon, hh, roll, pitch, yaw] = c;
-    let (sl, cl) = lat[0].sin_cos();
+    let [_, lon, hh, roll, pitch, yaw] = c;
+    let lat = &c[0];
+    let [(sl, cl), (sr, cr), (sp, cp), (sy, cy)] = *trig;
     let (l1, l2) = (lat[1], lat[2]);
     let (o1, o2) = (lon[1], lon[2]);
     let sin_lat = Jet {
@@ -253,9 +255,6 @@ fn geodetic_kinematics<E: EarthModel>(
     let f_n = to_ned(f_m) - g_n;
     let v_n = to_ned(v_m);
 
-    let (sr, cr) = roll[0].sin_cos();
-    let (sp, cp) = pitch[0].sin_cos();
-    let (sy, cy) = yaw[0].sin_cos();
     let c_bn = nalgebra::Matrix3::new(
         cp * cy,
         -cr * sy + sr * sp * cy,
@@ -284,10 +283,32 @@ fn geodetic_kinematics<E: EarthModel>(
     )
 }
 
+/// Sines and cosines `(sin, cos)` of latitude, roll, pitch and yaw.
+pub type Trig = [(f64, f64); 4];
+
+/// The [`Trig`] of `c`'s angles.
+pub fn trig(c: &GeodeticEuler) -> Trig {
+    [
+        c[0][0].sin_cos(),
+        c[3][0].sin_cos(),
+        c[4][0].sin_cos(),
+        c[5][0].sin_cos(),
+    ]
+}
+
 /// True kinematics from geodetic position and Euler angles with their derivatives
 /// (closed form, see [`evaluate_geodetic`]).
 pub fn kinematics_geodetic<E: EarthModel>(earth: &E, c: &GeodeticEuler) -> Kinematics {
-    geodetic_kinematics(earth, c).0
+    kinematics_geodetic_with(earth, c, &trig(c))
+}
+
+/// [`kinematics_geodetic`] given the sines and cosines of `c`'s angles.
+pub fn kinematics_geodetic_with<E: EarthModel>(
+    earth: &E,
+    c: &GeodeticEuler,
+    trig: &Trig,
+) -> Kinematics {
+    geodetic_kinematics(earth, c, trig).0
 }
 
 /// True state at time `t` and kinematics from geodetic position and Euler angles with
@@ -299,7 +320,17 @@ pub fn evaluate_geodetic<E: EarthModel>(
     t: f64,
     c: &GeodeticEuler,
 ) -> (NavState, Kinematics) {
-    let (kin, x) = geodetic_kinematics(earth, c);
+    evaluate_geodetic_with(earth, t, c, &trig(c))
+}
+
+/// [`evaluate_geodetic`] given the sines and cosines of `c`'s angles.
+pub fn evaluate_geodetic_with<E: EarthModel>(
+    earth: &E,
+    t: f64,
+    c: &GeodeticEuler,
+    trig: &Trig,
+) -> (NavState, Kinematics) {
+    let (kin, x) = geodetic_kinematics(earth, c, trig);
     let state = NavState {
         t,
         pos: Geodetic::new(c[0][0], crate::rotation::wrap_pi(c[1][0]), c[2][0]),
