@@ -164,6 +164,14 @@ impl TriadState {
             Some(st) if st.dt == dt => st,
             _ => *self.step.insert(Step::new(m, dt)),
         };
+        let mis = &m.misalignment;
+        // The cross-axis terms `Σ_{j != i} M_ij x_j`, in that order (and from zero, as
+        // a sum: the same bits).
+        let cross = [
+            mis[(0, 1)] * x[1] + mis[(0, 2)] * x[2],
+            mis[(1, 0)] * x[0] + mis[(1, 2)] * x[2],
+            mis[(2, 0)] * x[0] + mis[(2, 1)] * x[1],
+        ];
         let mut y = Vector3::zeros();
         for i in 0..3 {
             if m.gm_sigma[i] > 0.0 && m.gm_tau[i] > 0.0 {
@@ -171,14 +179,9 @@ impl TriadState {
             }
             self.rw[i] += m.random_walk[i] * step.sqrt_dt * w_rw[i];
             let gain = 1.0 + m.scale[i] + m.asymmetry[i] * x[i].signum();
-            let mut cross = 0.0;
-            for j in 0..3 {
-                if j != i {
-                    cross += m.misalignment[(i, j)] * x[j];
-                }
-            }
             let bias = m.bias[i] + self.turn_on[i] + self.gm[i] + self.rw[i];
-            y[i] = gain * x[i] + cross + bias * dt + m.white[i] * step.sqrt_dt * w_white[i];
+            y[i] =
+                gain * x[i] + (0.0 + cross[i]) + bias * dt + m.white[i] * step.sqrt_dt * w_white[i];
         }
         y
     }
