@@ -123,35 +123,44 @@ impl Noise {
     /// trigonometry; the rare wedge and tail cases draw more. Several times faster than
     /// [`Noise::normal`], for the per-sample sensor noise; another sequence of variates
     /// from the same stream.
+    #[inline]
     pub fn normal_ziggurat(&mut self) -> f64 {
         let x = self.edges;
-        loop {
-            let bits = self.bits();
-            let i = (bits & 0xff) as usize;
-            // Signed uniform in (-1, 1) from the top 53 bits, never 0.
-            let u = ((bits >> 11) as f64 + 0.5) * (2.0 / (1u64 << 53) as f64) - 1.0;
-            let z = u * x[i];
-            if z.abs() < x[i + 1] {
-                return z;
-            }
-            if i == 0 {
-                // The tail beyond r (Marsaglia 1964): x = -ln(U1)/r, y = -ln(U2),
-                // accepted when 2y > x².
-                loop {
-                    let t = -self.uniform().ln() / ZIG_R;
-                    let y = -self.uniform().ln();
-                    if 2.0 * y > t * t {
-                        return if u < 0.0 { -(ZIG_R + t) } else { ZIG_R + t };
-                    }
+        let bits = self.bits();
+        let i = (bits & 0xff) as usize;
+        // Signed uniform in (-1, 1) from the top 53 bits, never 0.
+        let u = ((bits >> 11) as f64 + 0.5) * (2.0 / (1u64 << 53) as f64) - 1.0;
+        let z = u * x[i];
+        if z.abs() < x[i + 1] {
+            return z;
+        }
+        self.normal_ziggurat_edge(i, u, z)
+    }
+
+    /// [`Noise::normal_ziggurat`] past the rectangle of layer `i` (1 % of the draws):
+    /// the tail or the wedge, then again from the start if refused.
+    #[cold]
+    #[inline(never)]
+    fn normal_ziggurat_edge(&mut self, i: usize, u: f64, z: f64) -> f64 {
+        let x = self.edges;
+        if i == 0 {
+            // The tail beyond r (Marsaglia 1964): x = -ln(U1)/r, y = -ln(U2),
+            // accepted when 2y > x².
+            loop {
+                let t = -self.uniform().ln() / ZIG_R;
+                let y = -self.uniform().ln();
+                if 2.0 * y > t * t {
+                    return if u < 0.0 { -(ZIG_R + t) } else { ZIG_R + t };
                 }
             }
-            // Wedge between the layer's rectangle and the density.
-            let f0 = (-0.5 * (x[i] * x[i] - z * z)).exp();
-            let f1 = (-0.5 * (x[i + 1] * x[i + 1] - z * z)).exp();
-            if f1 + self.uniform() * (f0 - f1) < 1.0 {
-                return z;
-            }
         }
+        // Wedge between the layer's rectangle and the density.
+        let f0 = (-0.5 * (x[i] * x[i] - z * z)).exp();
+        let f1 = (-0.5 * (x[i + 1] * x[i + 1] - z * z)).exp();
+        if f1 + self.uniform() * (f0 - f1) < 1.0 {
+            return z;
+        }
+        self.normal_ziggurat()
     }
 }
 
