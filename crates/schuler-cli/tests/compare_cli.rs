@@ -141,9 +141,9 @@ fn truth_against_itself_is_zero() {
 /// nalgebra's rotations: north the ECEF difference along the truth's north
 /// ([`wgs84_north_offset`]: 1e-5 deg x (R_M + h), 1.1 m, and 0.25 m x δ = 4.4e-8 m
 /// more for the height); east zero; down -0.25 m; velocity `R_y(−δ) v − v` (down
-/// about `v_N δ`, up to 4e-6 m/s); attitude the Euler angles of `R_y(−δ) C_bn` (yaw
-/// + 0.5 deg) minus the truth's (roll and pitch about `δ` = 1.7e-7 rad, yaw 0.5 deg
-/// and `δ tan(pitch) sin(yaw)`).
+/// about `v_N δ`, up to 4e-6 m/s); attitude the Euler angles of `R_y(−δ) C_bn`, with
+/// yaw 0.5 deg more, minus the truth's (roll and pitch about `δ` = 1.7e-7 rad, yaw
+/// 0.5 deg and `δ tan(pitch) sin(yaw)`).
 ///
 /// Tolerances: the copy is written with shortest round-trip numbers, so the file holds
 /// the f64 of lat + 1e-5 used here; the ECEF coordinates (6.4e6 m) round to 1e-9 m, the
