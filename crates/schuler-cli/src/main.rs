@@ -49,8 +49,52 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", chain_message(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// `e` and its causes on one line, `a: b: c` as anyhow's `{:#}` prints them, each
+/// message once: a cause whose message the line already ends with is left out (an
+/// error that puts its source's message in its own, such as the simulator's
+/// `SimError::Io`, would otherwise repeat it).
+fn chain_message(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let m = cause.to_string();
+        if line.is_empty() {
+            line = m;
+        } else if !line.ends_with(&m) {
+            line.push_str(": ");
+            line.push_str(&m);
+        }
+    }
+    line
+}
+
+#[cfg(test)]
+mod tests {
+    use super::chain_message;
+
+    /// An error that shows its source in its own message as well.
+    #[derive(Debug, thiserror::Error)]
+    #[error("writing failed: {0}")]
+    struct Repeats(#[from] std::io::Error);
+
+    #[test]
+    fn each_message_once() {
+        let io = || std::io::Error::other("disk full");
+        let e = anyhow::Error::new(Repeats(io())).context("in a.toml");
+        assert_eq!(
+            format!("{e:#}"),
+            "in a.toml: writing failed: disk full: disk full"
+        );
+        assert_eq!(chain_message(&e), "in a.toml: writing failed: disk full");
+        // A chain without repetition is anyhow's.
+        let e = anyhow::Error::new(io())
+            .context("reading b")
+            .context("in a.toml");
+        assert_eq!(chain_message(&e), format!("{e:#}"));
     }
 }

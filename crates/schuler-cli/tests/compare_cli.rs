@@ -11,7 +11,7 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 mod common;
 
-use nalgebra::Vector3;
+use nalgebra::{Rotation3, Vector3};
 use schuler::rotation::Euler;
 
 /// The drive9min truth (100 Hz, 53,000 rows) as text lines.
@@ -82,14 +82,23 @@ fn errors_csv(out: &Path) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Meridian radius of curvature of WGS84 [m], written out here from its definition
-/// (a = 6378137 m, f = 1/298.257223563): `R_M = a (1 - e^2) / (1 - e^2 sin^2 lat)^1.5`.
-fn wgs84_meridian_radius(lat_deg: f64) -> f64 {
+/// North error [m] of the point at (`lat_deg`, `h`) against the truth at (`lat_t_deg`,
+/// `h_t`) on the same meridian: their ECEF difference in the meridian plane along the
+/// truth's north, `−sin φ_t Δρ + cos φ_t Δz`, with `ρ = (N + h) cos φ`,
+/// `z = (N (1 − e²) + h) sin φ`, `N = a / sqrt(1 − e² sin² φ)`, WGS84 written out here
+/// from its definition (a = 6378137 m, f = 1/298.257223563).
+fn wgs84_north_offset(lat_t_deg: f64, h_t: f64, lat_deg: f64, h: f64) -> f64 {
     let a = 6_378_137.0;
     let f = 1.0 / 298.257_223_563;
     let e2 = f * (2.0 - f);
-    let s = lat_deg.to_radians().sin();
-    a * (1.0 - e2) / (1.0 - e2 * s * s).powf(1.5)
+    let rho_z = |lat_deg: f64, h: f64| {
+        let (s, c) = lat_deg.to_radians().sin_cos();
+        let n = a / (1.0 - e2 * s * s).sqrt();
+        ((n + h) * c, (n * (1.0 - e2) + h) * s)
+    };
+    let ((rho_t, z_t), (rho, z)) = (rho_z(lat_t_deg, h_t), rho_z(lat_deg, h));
+    let (s, c) = lat_t_deg.to_radians().sin_cos();
+    -s * (rho - rho_t) + c * (z - z_t)
 }
 
 /// (1) The truth against itself: every error is exactly zero, all epochs exact.
@@ -126,15 +135,22 @@ fn truth_against_itself_is_zero() {
 
 /// (2) A copy with +1e-5 deg latitude, +0.25 m height and +0.5 deg yaw on every row
 /// (yaw written back into [0, 360), so rows at 359.5..360 deg wrap to 0..0.5), as
-/// schuler's nav.csv: north error = 1e-5 deg x (R_M + h) with R_M at the truth's
-/// latitude, computed here from the WGS84 definition; down error -0.25 m; yaw error
-/// 0.5 deg; everything else zero.
+/// schuler's nav.csv. Its NED frame is the truth's turned about east by the latitude
+/// difference `δ` (the normals at two geodetic latitudes of one meridian are `δ`
+/// apart): `C_nt = R_y(−δ)`. The errors, computed here from the WGS84 definition and
+/// nalgebra's rotations: north the ECEF difference along the truth's north
+/// ([`wgs84_north_offset`]: 1e-5 deg x (R_M + h), 1.1 m, and 0.25 m x δ = 4.4e-8 m
+/// more for the height); east zero; down -0.25 m; velocity `R_y(−δ) v − v` (down
+/// about `v_N δ`, up to 4e-6 m/s); attitude the Euler angles of `R_y(−δ) C_bn`, with
+/// yaw 0.5 deg more, minus the truth's (roll and pitch about `δ` = 1.7e-7 rad, yaw
+/// 0.5 deg and `δ tan(pitch) sin(yaw)`).
 ///
-/// Tolerances: the copy is written with shortest round-trip numbers, so the file
-/// holds the f64 nearest to lat + 1e-5 (off by at most half an ulp of 45 deg,
-/// 3.6e-15 deg = 4e-10 m); the degree-to-radian conversions and the difference add a
-/// few ulps of 0.79 rad (1.1e-16 rad = 7e-10 m each): 1e-8 m covers them with margin.
-/// Yaw: ulps of 360 deg are 5.7e-14 deg, so 1e-10 deg; height: ulps of 300 m, 1e-12 m.
+/// Tolerances: the copy is written with shortest round-trip numbers, so the file holds
+/// the f64 of lat + 1e-5 used here; the ECEF coordinates (6.4e6 m) round to 1e-9 m, the
+/// degree-to-radian conversions and the difference a few ulps of 0.79 rad (1.1e-16
+/// rad = 7e-10 m each): 1e-8 m covers them with margin. Angles: ulps of 360 deg are
+/// 5.7e-14 deg, so 1e-10 deg; height: ulps of 300 m, 1e-12 m; velocity: ulps of
+/// 20 m/s, 1e-12 m/s.
 #[test]
 fn injected_offsets_come_out_exactly() {
     let lines = truth_lines();
@@ -143,6 +159,7 @@ fn injected_offsets_come_out_exactly() {
             .to_owned(),
     ];
     let mut expected_north = Vec::new();
+    let mut expected_v_att = Vec::new();
     let mut wrapped = 0;
     for l in &lines {
         let r: Vec<f64> = l
@@ -169,7 +186,22 @@ fn injected_offsets_come_out_exactly() {
             r[9],
             yaw
         ));
-        expected_north.push(1e-5f64.to_radians() * (wgs84_meridian_radius(r[2]) + r[4]));
+        expected_north.push(wgs84_north_offset(r[2], r[4], r[2] + 1e-5, r[4] + 0.25));
+        let c_nt =
+            Rotation3::from_axis_angle(&Vector3::y_axis(), -(r[2] + 1e-5 - r[2]).to_radians());
+        let v = Vector3::new(r[5], r[6], r[7]);
+        let rad = |x: f64| x.to_radians();
+        let (roll, pitch, yaw_nav) =
+            (c_nt * Rotation3::from_euler_angles(rad(r[8]), rad(r[9]), rad(yaw))).euler_angles();
+        let wrap = |x: f64| (x + 180.0).rem_euclid(360.0) - 180.0;
+        expected_v_att.push([
+            c_nt * v - v,
+            Vector3::new(
+                wrap(roll.to_degrees() - r[8]),
+                wrap(pitch.to_degrees() - r[9]),
+                wrap(yaw_nav.to_degrees() - r[10]),
+            ),
+        ]);
     }
     // 26 rows of the drive (its circle) have yaw in [359.5, 360).
     assert!(
@@ -186,7 +218,7 @@ fn injected_offsets_come_out_exactly() {
     assert_eq!(j["epochs"]["exact"], 53000);
     let rows = errors_csv(&out);
     assert_eq!(rows.len(), 53000);
-    for (row, north) in rows.iter().zip(&expected_north) {
+    for ((row, north), [dv, att]) in rows.iter().zip(&expected_north).zip(&expected_v_att) {
         assert!(
             (row[1] - north).abs() < 1e-8,
             "t {}: north {} vs {north}",
@@ -196,9 +228,18 @@ fn injected_offsets_come_out_exactly() {
         assert!(row[2].abs() < 1e-8, "east {}", row[2]);
         assert!((row[3] + 0.25).abs() < 1e-12, "down {}", row[3]);
         assert!((row[4] - north).abs() < 1e-8, "horizontal");
-        assert!(row[5..10].iter().all(|x| *x == 0.0), "{row:?}");
         assert!(
-            (row[10] - 0.5).abs() < 1e-10,
+            (Vector3::new(row[5], row[6], row[7]) - dv).norm() < 1e-12,
+            "t {}: velocity {row:?} vs {dv}",
+            row[0]
+        );
+        assert!(
+            (Vector3::new(row[8], row[9], row[10]) - att).abs().max() < 1e-10,
+            "t {}: attitude {row:?} vs {att}",
+            row[0]
+        );
+        assert!(
+            (row[10] - 0.5).abs() < 1e-6,
             "t {}: yaw {}",
             row[0],
             row[10]
@@ -208,8 +249,9 @@ fn injected_offsets_come_out_exactly() {
     // The table agrees with the rows: RMS and max of a near-constant north error.
     let max_north = expected_north.iter().fold(0.0f64, |m, x| m.max(*x));
     assert!((stat(&j, "north_m", "max") - max_north).abs() < 1e-8);
-    assert!((stat(&j, "yaw_deg", "mean") - 0.5).abs() < 1e-10);
-    assert!((stat(&j, "yaw_deg", "p95") - 0.5).abs() < 1e-10);
+    let yaw_mean = expected_v_att.iter().map(|[_, a]| a.z).sum::<f64>() / 53000.0;
+    assert!((stat(&j, "yaw_deg", "mean") - yaw_mean).abs() < 1e-10);
+    assert!((stat(&j, "yaw_deg", "p95") - 0.5).abs() < 1e-6);
     assert!((stat(&j, "vertical_m", "mean") + 0.25).abs() < 1e-12);
     let h3 = stat(&j, "3_d_m", "max");
     assert!(
@@ -378,6 +420,7 @@ fn north_errors(h: &[f64]) -> Vec<EpochErrors> {
             pos_n: Vector3::new(x, 0.0, -x / 2.0),
             v_n: Vector3::zeros(),
             att: Euler::new(0.0, 0.0, x.to_radians() / 100.0),
+            psi: Vector3::new(0.0, 0.0, -x.to_radians() / 100.0),
             interpolated: false,
         })
         .collect()

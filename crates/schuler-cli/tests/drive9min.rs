@@ -2,7 +2,9 @@
 //! drive made by gnss-ins-sim (not by schuler), with KF-GINS's published figures on the
 //! same data (`../shared/data/drive9min/README.md`).
 
-use schuler::earth::{EarthModel, Geodetic, Wgs84};
+use nalgebra::Vector3;
+use schuler::analysis::errors::{EpochErrors, NavRecord, errors_at};
+use schuler::earth::{Geodetic, Wgs84};
 use schuler::rotation::Euler;
 use schuler_cli::commands::nav::{EarthChoice, NavSettings, navigate};
 use schuler_cli::formats::{ImuReadOptions, ImuReader};
@@ -23,14 +25,27 @@ fn unpack(dir: &Path, name: &str) -> PathBuf {
     dst
 }
 
+/// A KF-GINS navigation row (week, sow, lat, lon, h, v NED, roll, pitch, yaw) as a
+/// record.
+fn record(r: &[f64]) -> NavRecord {
+    NavRecord {
+        t_sow: r[1],
+        pos: Geodetic::from_degrees(r[2], r[3], r[4]),
+        v_n: Vector3::new(r[5], r[6], r[7]),
+        att: Euler::from_degrees(r[8], r[9], r[10]),
+    }
+}
+
+/// Errors of the KF-GINS navigation row `r` against the truth row `t` (the library's,
+/// as `schuler compare` takes them).
+fn row_errors(r: &[f64], t: &[f64]) -> EpochErrors {
+    errors_at(&record(r), &record(t))
+}
+
 /// Horizontal distance [m] between the positions of two KF-GINS navigation rows
-/// (`r` against the truth row `t`), on WGS84 radii at the truth.
+/// (`r` against the truth row `t`).
 fn horizontal_error(r: &[f64], t: &[f64]) -> f64 {
-    let truth = Geodetic::from_degrees(t[2], t[3], t[4]);
-    let radii = Wgs84.radii(truth.lat);
-    let dn = (r[2] - t[2]).to_radians() * (radii.meridian + truth.h);
-    let de = (r[3] - t[3]).to_radians() * (radii.prime_vertical + truth.h) * truth.lat.cos();
-    dn.hypot(de)
+    row_errors(r, t).horizontal()
 }
 
 /// Horizontal RMS and max, vertical max [m], and the largest roll/pitch/yaw error
@@ -52,13 +67,12 @@ fn errors(nav: &Path, truth: &Path) -> Errors {
     let (mut sum2, mut hmax, mut vmax, mut amax, mut n) = (0.0, 0.0f64, 0.0f64, 0.0f64, 0);
     for r in common::read_rows(nav) {
         let t = by_time[&((r[1] * 100.0).round() as i64)];
-        let h = horizontal_error(r.as_slice(), t);
+        let e = row_errors(r.as_slice(), t);
+        let h = e.horizontal();
         sum2 += h * h;
         hmax = hmax.max(h);
-        vmax = vmax.max((r[4] - t[4]).abs());
-        let q = Euler::from_degrees(r[8], r[9], r[10]).to_quaternion();
-        let qt = Euler::from_degrees(t[8], t[9], t[10]).to_quaternion();
-        amax = amax.max(q.angle_to(&qt).to_degrees());
+        vmax = vmax.max(e.pos_n.z.abs());
+        amax = amax.max(e.psi.norm().to_degrees());
         n += 1;
     }
     Errors {
@@ -142,13 +156,13 @@ fn attitude_rms_and_outage_max(nav: &Path, truth: &Path) -> ([f64; 3], f64) {
     let (mut s, mut n, mut outage) = ([0.0; 3], 0, 0.0f64);
     for r in common::read_rows(nav) {
         let t = by_time[&((r[1] * 100.0).round() as i64)];
-        for k in 0..3 {
-            let d = (r[8 + k] - t[8 + k] + 180.0).rem_euclid(360.0) - 180.0;
-            s[k] += d * d;
+        let e = row_errors(&r, t);
+        for (k, d) in [e.att.roll, e.att.pitch, e.att.yaw].into_iter().enumerate() {
+            s[k] += d.to_degrees().powi(2);
         }
         n += 1;
         if (215.0..=277.0).contains(&r[1]) {
-            outage = outage.max(horizontal_error(&r, t));
+            outage = outage.max(e.horizontal());
         }
     }
     (s.map(|x| (x / n as f64).sqrt()), outage)

@@ -205,6 +205,40 @@ pub fn c_ne(lat: f64, lon: f64) -> Matrix3<f64> {
     )
 }
 
+/// Rotation from the NED frame at `from` to the NED frame at `to`,
+/// `C_ne(to)ᵀ C_ne(from)` ([`c_ne`]; rows `to`'s north, east, down, columns `from`'s),
+/// written with the latitude and longitude differences `δφ = φ − φ_t`, `δλ = λ − λ_t`
+/// (`φ, λ` of `from`, `φ_t, λ_t` of `to`) and `k = 1 − cos δλ = 2 sin²(δλ/2)`:
+///
+/// ```text
+/// | cos δφ − sin φ_t sin φ k    sin φ_t sin δλ   −sin δφ − sin φ_t cos φ k |
+/// | −sin φ sin δλ               cos δλ           −cos φ sin δλ             |
+/// | sin δφ − cos φ_t sin φ k    cos φ_t sin δλ   cos δφ − cos φ_t cos φ k  |
+/// ```
+///
+/// so that it is exactly the identity at the same position and free of the
+/// cancellation of the product near it. Valid at any latitudes, ±90° included.
+pub fn c_ned_to_ned(from: &Geodetic, to: &Geodetic) -> Matrix3<f64> {
+    let (s, c) = from.lat.sin_cos();
+    let (st, ct) = to.lat.sin_cos();
+    let (sd, cd) = (from.lat - to.lat).sin_cos();
+    let dl = from.lon - to.lon;
+    let half = (0.5 * dl).sin();
+    let k = 2.0 * half * half;
+    let sl = dl.sin();
+    Matrix3::new(
+        cd - st * s * k,
+        st * sl,
+        -sd - st * c * k,
+        -s * sl,
+        dl.cos(),
+        -c * sl,
+        sd - ct * s * k,
+        ct * sl,
+        cd - ct * c * k,
+    )
+}
+
 /// WGS84 with its normal gravity field (NIMA TR8350.2).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Wgs84;
@@ -390,6 +424,32 @@ mod tests {
     use approx::assert_relative_eq;
     use proptest::prelude::*;
     use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// The closed form of `c_ned_to_ned` is the product of the two frames (to 1e-15)
+    /// wherever they are, across the antimeridian, at and past the poles, and the
+    /// identity bit for bit at one position.
+    #[test]
+    fn ned_to_ned_is_the_product_of_the_two_frames() {
+        let pairs = [
+            ((45.0, 7.0), (45.001, 7.002)),
+            ((-30.0, 179.9), (-30.2, -179.8)),
+            ((89.9997, 25.0), (89.9997, -155.0)),
+            ((90.0, 0.0), (89.0, 120.0)),
+            ((-90.0, 10.0), (-89.5, -100.0)),
+            ((90.0003, 25.0), (89.9999, 200.0)),
+            ((10.0, 20.0), (-60.0, 300.0)),
+        ];
+        for ((la, lo), (lb, lob)) in pairs {
+            let (a, b) = (
+                Geodetic::from_degrees(la, lo, 0.0),
+                Geodetic::from_degrees(lb, lob, 0.0),
+            );
+            let product = c_ne(b.lat, b.lon).transpose() * c_ne(a.lat, a.lon);
+            let c = c_ned_to_ned(&a, &b);
+            assert!((c - product).abs().max() < 1e-15, "{a:?} {b:?}");
+            assert_eq!(c_ned_to_ned(&a, &a), Matrix3::identity());
+        }
+    }
 
     /// TR8350.2 table 3.4: normal gravity at the equator and the poles; Somigliana's
     /// formula reproduces its own endpoints to the printed digits (1e-10 m/s^2).

@@ -11,6 +11,7 @@
 
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, AlignError, Alignment, HeadingSource, align};
+use schuler::analysis::errors::errors_between;
 use schuler::earth::{EarthModel, Geodetic, Wgs84};
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
@@ -238,11 +239,9 @@ fn fine_alignment_beats_coarse_in_one_hour_of_free_inertial_navigation() {
                 ..*s
             };
             nav.step(&c);
-            let p = nav.state().pos;
-            let r = Wgs84.radii(pos.lat);
-            let n = (p.lat - pos.lat) * r.meridian;
-            let e = (p.lon - pos.lon) * r.prime_vertical * pos.lat.cos();
-            worst = worst.max(n.hypot(e));
+            let s = nav.state();
+            let at_rest = NavState { pos, ..s };
+            worst = worst.max(errors_between(&Wgs84, &s, &at_rest).horizontal());
         }
         worst
     };

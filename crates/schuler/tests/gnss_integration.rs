@@ -5,7 +5,7 @@
 
 use nalgebra::Vector3;
 use schuler::analysis::consistency::{ChiSquareTest, mean_bounds, normalized_squared};
-use schuler::analysis::errors::attitude_error;
+use schuler::analysis::errors::errors_between;
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::ImuNoise;
 use schuler::filter::integration::{GnssFix, Innovation, IntegrationConfig, Integrator};
@@ -260,14 +260,11 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
         if (truth.t - truth.t.round()).abs() < 1e-6 {
             integ.record_output();
             let est = integ.state();
-            let c_en = schuler::earth::c_ne(truth.pos.lat, truth.pos.lon).transpose();
-            let dr = c_en * (Wgs84.geodetic_to_ecef(&est.pos) - Wgs84.geodetic_to_ecef(&truth.pos));
-            let dv = est.v_n - truth.v_n;
-            let psi = attitude_error(&est.q_bn, &truth.q_bn);
+            let err = errors_between(&Wgs84, &est, truth);
             let mut e = [0.0; 9];
-            e[..3].copy_from_slice(dr.as_slice());
-            e[3..6].copy_from_slice(dv.as_slice());
-            e[6..].copy_from_slice(psi.as_slice());
+            e[..3].copy_from_slice(err.pos_n.as_slice());
+            e[3..6].copy_from_slice(err.v_n.as_slice());
+            e[6..].copy_from_slice(err.psi.as_slice());
             let p = integ.covariance().fixed_view::<9, 9>(0, 0).into_owned();
             epochs.push(Epoch { t: truth.t, e, p });
         }
@@ -289,10 +286,10 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
         .iter()
         .map(|s| {
             let truth = truth_at(s.state.t);
-            let c_en = schuler::earth::c_ne(truth.pos.lat, truth.pos.lon).transpose();
-            let dr =
-                c_en * (Wgs84.geodetic_to_ecef(&s.state.pos) - Wgs84.geodetic_to_ecef(&truth.pos));
-            (s.state.t, dr.x.hypot(dr.y))
+            (
+                s.state.t,
+                errors_between(&Wgs84, &s.state, &truth).horizontal(),
+            )
         })
         .collect();
     Run {

@@ -3,6 +3,7 @@
 //! departure from the truth is the mechanization's own error.
 
 use nalgebra::Vector3;
+use schuler::analysis::errors::errors_between;
 use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
 use schuler::imu::ImuSample;
 use schuler::nav::{Corrections, LocalLevel, Mechanization, NavState};
@@ -11,12 +12,10 @@ use schuler::sim::analytic::{self, Coning, Maneuvering, Sculling, Stationary, Tr
 
 const ARCSEC: f64 = std::f64::consts::PI / (180.0 * 3600.0);
 
-/// North/east position difference [m] of `a` relative to `b`.
+/// Horizontal position difference [m] of `a` relative to `b` (the library's epoch
+/// errors, through ECEF).
 fn horizontal_error<E: EarthModel>(earth: &E, a: &NavState, b: &NavState) -> f64 {
-    let r = earth.radii(b.pos.lat);
-    let dn = (a.pos.lat - b.pos.lat) * (r.meridian + b.pos.h);
-    let de = (a.pos.lon - b.pos.lon) * (r.prime_vertical + b.pos.h) * b.pos.lat.cos();
-    dn.hypot(de)
+    errors_between(earth, a, b).horizontal()
 }
 
 /// Runs the mechanization from the truth at t = 0 over `n` exact samples at `dt`,

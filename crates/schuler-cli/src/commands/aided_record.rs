@@ -20,8 +20,8 @@ use super::nav::Decimator;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::analysis::consistency::normalized_squared;
-use schuler::analysis::errors::{NavRecord, TruthAt, TruthCursor, attitude_error, errors_at};
-use schuler::earth::EarthModel;
+use schuler::analysis::errors::{NavRecord, TruthAt, TruthCursor, errors_between};
+use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::Innovation;
 use schuler::filter::measurement::Kind;
 use schuler::filter::{Integrator, Layout, SensorEstimates};
@@ -231,13 +231,12 @@ impl<'a> RunRecorder<'a> {
         } else {
             match self.cursor.at(self.truth, state.t) {
                 TruthAt::Exact(truth) | TruthAt::Interpolated(truth, _) => {
-                    let e = errors_at(&NavRecord::from(&state), &truth);
-                    let psi = attitude_error(&state.q_bn, &truth.att.to_quaternion());
+                    let e = errors_between(&Wgs84, &state, &(&truth).into());
                     let [pp, pv, pa] = integ.nav_covariance();
                     Some([
                         normalized_squared(&e.pos_n, &pp),
                         normalized_squared(&e.v_n, &pv),
-                        normalized_squared(&psi, &pa),
+                        normalized_squared(&e.psi, &pa),
                     ])
                 }
                 TruthAt::Before | TruthAt::After => None,

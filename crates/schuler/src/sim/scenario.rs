@@ -205,7 +205,9 @@ pub struct MotionSpec {
     pub motion: Vec<SegmentSpec>,
 }
 
-/// Why a scenario is invalid: the key and the reason.
+/// Why a scenario is invalid: the key and the reason. A [`ScenarioError::Motion`]
+/// names the key and gives the motion's error as its `source()`, as an error chain
+/// does (anyhow's `{:#}`, `key: reason`), not in its own message as well.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ScenarioError {
@@ -217,8 +219,8 @@ pub enum ScenarioError {
         /// Why.
         message: String,
     },
-    /// The motion could not be integrated.
-    #[error("{key}: {source}")]
+    /// The motion could not be integrated; why is the `source()`.
+    #[error("{key}")]
     Motion {
         /// Segment key.
         key: String,
@@ -990,5 +992,21 @@ mod tests {
             e.to_string().contains("hover needs the vehicle at rest"),
             "{e}"
         );
+    }
+
+    /// A motion that flies past 89.9 deg names its key, with the reason as the error's
+    /// source and not in its message too (a chain printer would show it twice): from
+    /// 89.89 deg north at 50 m/s, 1.1 km from the limit, a 60-s hold reaches it.
+    #[test]
+    fn a_motion_error_gives_its_reason_once() {
+        let text = "[start]\nposition = [\"89.89 deg\", \"7 deg\", \"100 m\"]\nattitude = [\"0 deg\", \"0 deg\", \"0 deg\"]\nspeed = \"50 m/s\"\n[[motion]]\ntype = \"hold\"\nduration = \"60 s\"\n";
+        let e = toml::from_str::<MotionSpec>(text)
+            .expect("valid TOML")
+            .build(Wgs84)
+            .unwrap_err();
+        assert!(matches!(e, ScenarioError::Motion { .. }), "{e:?}");
+        assert_eq!(e.to_string(), "motion[0]");
+        let reason = std::error::Error::source(&e).expect("a source").to_string();
+        assert!(reason.contains("reaches latitude 89.9"), "{reason}");
     }
 }

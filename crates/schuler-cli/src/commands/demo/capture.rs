@@ -5,7 +5,7 @@
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use nalgebra::Vector3;
-use schuler::earth::{EarthModel, Wgs84, c_ne};
+use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::GnssFix;
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
@@ -177,12 +177,9 @@ fn samples_per(interval: f64, rate: f64, what: &str) -> Result<usize> {
 /// scripting (latitude and longitude rates) stops at 89.9 deg. The increments are
 /// [`analytic::increment_from`]'s quadrature of the exact rates; GNSS fixes and
 /// barometer readings fall on IMU sample times, every `1/rate_hz` of their own.
-/// Two things differ from [`simulate`], both for the pole: the antenna's lever-arm
-/// velocity uses the body rate relative to the Earth, `w_eb_b = w_ib_b − C_bn^T
-/// w_ie_n` (as the filter predicts it; the scripted simulator's rate relative to NED
-/// adds the transport rate, which near a pole grows without bound), and the fix's NED
-/// velocity is resolved at the fix's own reported position, as a receiver resolves
-/// its ECEF solution (near a pole a metre of position noise turns north by degrees).
+/// The receiver gets the body rate relative to the Earth, `w_eb_b = w_ib_b − C_bn^T
+/// w_ie_n` ([`GnssSimulator::fix_w_eb`]), defined at the pole, where the rate
+/// relative to NED that [`simulate`] passes is not.
 pub fn record_trajectory<T: Trajectory>(
     traj: &T,
     t0: f64,
@@ -223,10 +220,7 @@ pub fn record_trajectory<T: Trajectory>(
             let c_bn = truth.q_bn.to_rotation_matrix().into_inner();
             let w_ie_n = earth.local(truth.pos.lat, truth.pos.h).w_ie_n();
             let w_eb_b = kin.w_ib_b - c_bn.transpose() * w_ie_n;
-            if let Some(mut fix) = g.fix(&earth, &truth, &w_eb_b) {
-                fix.v_n = c_ne(fix.pos.lat, fix.pos.lon).transpose()
-                    * c_ne(truth.pos.lat, truth.pos.lon)
-                    * fix.v_n;
+            if let Some(fix) = g.fix_w_eb(&earth, &truth, &w_eb_b) {
                 capture.gnss(&fix)?;
             }
         }

@@ -18,8 +18,8 @@
 
 use super::sortie::Sortie;
 use anyhow::{Context, Result};
-use nalgebra::Vector3;
-use schuler::earth::{EarthModel, Wgs84};
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use schuler::earth::{EarthModel, Wgs84, c_ned_to_ned};
 use schuler::nav::NavState;
 use schuler::rotation::quaternion_from_rotation_vector;
 use schuler::sim::analytic::{self, Trajectory};
@@ -121,8 +121,8 @@ impl Trajectory for PoleCrossing {
     }
 }
 
-/// Errors of the state navigation starts from, handed over in flight (NED at the
-/// start, navigated minus true).
+/// Errors of the state navigation starts from, handed over in flight (navigated minus
+/// true, in the truth's NED frame as [`schuler::analysis::errors`] takes them).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Handover {
     /// Position error [m].
@@ -242,15 +242,21 @@ impl Crossing {
     }
 
     /// The state navigation starts from: the truth at the start with the hand-over's
-    /// errors (position offset through ECEF).
+    /// errors, made in the truth's NED frame (position offset through ECEF) and carried
+    /// into the NED frame at the offset position, which 21 km from the pole is turned
+    /// by the meridian convergence over a metre east, 5e-5 rad (10″, 3 mm/s at 70
+    /// m/s).
     pub fn start(&self) -> NavState {
         let truth = self.truth(self.t0);
         let e = &self.handover;
+        let pos = offset_ned(&Wgs84, &truth.pos, &e.pos_n);
+        let c = c_ned_to_ned(&truth.pos, &pos);
+        let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c));
         NavState {
             t: truth.t,
-            pos: offset_ned(&Wgs84, &truth.pos, &e.pos_n),
-            v_n: truth.v_n + e.v_n,
-            q_bn: quaternion_from_rotation_vector(&-e.psi) * truth.q_bn,
+            pos,
+            v_n: c * (truth.v_n + e.v_n),
+            q_bn: q * quaternion_from_rotation_vector(&-e.psi) * truth.q_bn,
         }
     }
 }
@@ -312,8 +318,9 @@ mod tests {
         );
     }
 
-    /// The hand-over is the truth with the stated errors: position offset 1.5 m,
-    /// attitude turned by the stated angles (0.7' level, 3' heading).
+    /// The hand-over is the truth with the stated errors: position offset 1.5 m
+    /// (through ECEF; height to the Earth's curvature under 1.4 m, 1.5e-7 m), velocity
+    /// and attitude turned by the stated amounts (0.7' level, 3' heading) in space.
     #[test]
     fn start_carries_the_handover_errors() {
         let c = crossing();
@@ -321,7 +328,9 @@ mod tests {
         let d = Wgs84.geodetic_to_ecef(&start.pos) - Wgs84.geodetic_to_ecef(&truth.pos);
         let d_n = c_ne(truth.pos.lat, truth.pos.lon).transpose() * d;
         assert!((d_n - c.handover.pos_n).norm() < 1e-6, "{d_n}");
-        let psi = schuler::analysis::errors::attitude_error(&start.q_bn, &truth.q_bn);
-        assert!((psi - c.handover.psi).norm() < 1e-12, "{psi}");
+        let e = schuler::analysis::errors::errors_between(&Wgs84, &start, &truth);
+        assert!((e.pos_n - c.handover.pos_n).norm() < 1e-6, "{e:?}");
+        assert!((e.v_n - c.handover.v_n).norm() < 1e-12, "{e:?}");
+        assert!((e.psi - c.handover.psi).norm() < 1e-12, "{e:?}");
     }
 }

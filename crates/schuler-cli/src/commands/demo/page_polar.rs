@@ -239,11 +239,11 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
          wander-to-Earth quaternion, the navigation frame's vertical rate relative to the \
          Earth held at zero, so nothing depends on the direction of north) navigates it in \
          the inertial mode with the baro loop and in the inertial-satellite mode, the \
-         filter's errors resolved in the wander frame. Errors are differences in ECEF \
-         resolved along the truth's north and east: the latitude and longitude differences \
-         schuler compare uses (R dlat, R cos(lat) dlon) fail here, because within tens of \
-         metres of the pole a metre of error spans degrees of longitude (two points 30 m \
-         from the pole on \
+         filter's errors resolved in the wander frame. Errors, as everywhere in schuler, are \
+         differences in ECEF resolved along the truth's north and east: latitude and \
+         longitude differences (R dlat, R cos(lat) dlon) would fail here, because within \
+         tens of metres of the pole a metre of error spans degrees of longitude (two \
+         points 30 m from the pole on \
          opposite meridians are 60 m apart, not 94 m), and each state's velocity and heading \
          are in its own north.",
     );

@@ -3,7 +3,7 @@
 //! in the inertial mode (baro loop) and the inertial-satellite mode (the filter's
 //! errors in the wander frame, forward and smoothed), and for contrast with the NED
 //! mechanization in the inertial mode on the same samples; errors through ECEF
-//! ([`super::errors::errors_near_pole`]).
+//! ([`super::errors::errors`]).
 
 use super::capture::{self, Recording};
 use super::crossing::Crossing;
@@ -81,9 +81,7 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
         ("polar_ned", "NED inertial with baro loop", ned),
     ]
     .into_iter()
-    .map(|(key, label, track)| {
-        ModeRun::new(key, label, track, |t| errors::errors_near_pole(t, &rec))
-    })
+    .map(|(key, label, track)| ModeRun::new(key, label, track, |t| errors::errors(t, &rec)))
     .collect();
     Ok(Polar {
         crossing,
