@@ -191,7 +191,7 @@ pub enum SimError {
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     /// The sink failed to write.
-    #[error("writing the simulated data failed: {0}")]
+    #[error("writing the simulated data failed")]
     Io(#[from] std::io::Error),
 }
 
@@ -254,11 +254,11 @@ pub fn simulate_with<T: Default + Send>(
     }
 }
 
-/// Angular rate of the body relative to the navigation frame, `w_nb_b = w_ib_b -
-/// C_nb (w_ie_n + w_en_n)`, for the GNSS lever-arm velocity.
-fn w_nb_b<E: EarthModel>(earth: &E, s: &NavState, k: &Kinematics) -> nalgebra::Vector3<f64> {
-    let l = earth.local(s.pos.lat, s.pos.h);
-    k.w_ib_b - s.q_bn.inverse() * (l.w_ie_n() + l.w_en_n(&s.v_n))
+/// Angular rate of the body relative to the Earth, `w_eb_b = w_ib_b - C_nb w_ie_n`,
+/// for the GNSS lever-arm velocity (defined at the poles, unlike the rate relative to
+/// NED).
+fn w_eb_b<E: EarthModel>(earth: &E, s: &NavState, k: &Kinematics) -> nalgebra::Vector3<f64> {
+    k.w_ib_b - s.q_bn.inverse() * earth.w_ie_n(s.pos.lat)
 }
 
 /// Samples per block: small enough that a worker's buffers stay in its cache (about
@@ -298,7 +298,7 @@ impl Sensors {
             if let Some(g) = self.gnss.as_mut() {
                 emit_epochs(&mut self.next_gnss, g.interval(), t0, t, |te| {
                     let (s, kin) = analytic::evaluate(earth, traj, te);
-                    if let Some(fix) = g.fix(earth, &s, &w_nb_b(earth, &s, &kin)) {
+                    if let Some(fix) = g.fix_w_eb(earth, &s, &w_eb_b(earth, &s, &kin)) {
                         block.gnss.push((i, fix));
                     }
                 });
