@@ -240,7 +240,34 @@ pub struct MotionBuilder<E: EarthModel> {
     t: f64,
     knots: Vec<Knot>,
     pieces: usize,
+    /// Who hears of the knots as they are made ([`MotionBuilder::feed`]).
+    feed: FeedSlot,
 }
+
+/// A builder's [`KnotFeed`], if any. A clone (a trial integration) has none: its
+/// knots are not the motion's.
+#[derive(Default)]
+struct FeedSlot(Option<KnotFeed>);
+
+impl Clone for FeedSlot {
+    fn clone(&self) -> Self {
+        Self(None)
+    }
+}
+
+impl std::fmt::Debug for FeedSlot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.is_some() { "fed" } else { "not fed" })
+    }
+}
+
+/// Receives every knot, in order, as soon as it is made: a long piece in chunks of
+/// [`FEED_CHUNK`], so that a consumer (the simulator's workers) can start on the
+/// beginning of a motion while the rest is integrated.
+pub type KnotFeed = Box<dyn FnMut(&[Knot]) + Send>;
+
+/// Knots per chunk a [`KnotFeed`] receives (10 s of motion at the longest step).
+pub const FEED_CHUNK: usize = 1000;
 
 impl<E: EarthModel> MotionBuilder<E> {
     /// Start at `start`.
@@ -263,7 +290,13 @@ impl<E: EarthModel> MotionBuilder<E> {
             t: start.t,
             knots: Vec::new(),
             pieces: 0,
+            feed: FeedSlot::default(),
         }
+    }
+
+    /// Send every knot from now on to `feed` as well.
+    pub fn feed(&mut self, feed: KnotFeed) {
+        self.feed = FeedSlot(Some(feed));
     }
 
     /// The Earth model.
@@ -295,6 +328,8 @@ impl<E: EarthModel> MotionBuilder<E> {
         let h = piece.duration / n as f64;
         let mut x = self.x;
         let mut knots = Vec::with_capacity(n + 1);
+        // Knots of this piece already sent to the feed.
+        let mut fed = 0;
         // The derivative at each knot is also the first stage of the next step.
         let mut d1 = derivative_value(&self.earth, piece, 0.0, &x);
         if self.knots.is_empty() {
@@ -312,6 +347,12 @@ impl<E: EarthModel> MotionBuilder<E> {
             let tau1 = (k + 1) as f64 * h;
             d1 = derivative_value(&self.earth, piece, tau1, &x);
             knots.push(knot(&self.earth, piece, self.t + tau1, tau1, &x, &d1));
+            if let Some(feed) = self.feed.0.as_mut()
+                && (knots.len() - fed >= FEED_CHUNK || k + 1 == n)
+            {
+                feed(&knots[fed..]);
+                fed = knots.len();
+            }
         }
         self.knots.extend(knots);
         self.x = x;

@@ -8,12 +8,12 @@
 use super::analytic::{self, Kinematics, Trajectory};
 use super::gnss_ins_sim::MotionDefinition;
 use super::imu_model::ImuSimulator;
-use super::motion::{MotionBuilder, Start};
+use super::motion::{KnotFeed, MotionBuilder, Start};
 use super::receivers::Interval;
 use super::receivers::{BaroReading, BaroSimulator, GnssFix, GnssSimulator};
 use super::scenario::{MotionSpec, ScenarioError, SegmentSpec, StartSpec};
 use super::sensor_spec::{BaroSpec, GnssSpec, ImuSpec};
-use super::spline::SplineTrajectory;
+use super::spline::{Knot, SplineTrajectory};
 use crate::earth::{EarthModel, Sphere, Wgs84};
 use crate::imu::ImuSample;
 use crate::nav::NavState;
@@ -78,8 +78,34 @@ impl ScenarioSpec {
         &self,
         earth: E,
     ) -> Result<(SplineTrajectory, Vec<Interval>), ScenarioError> {
+        Ok((self.trajectory_fed(earth, None)?, self.motion_outages()))
+    }
+
+    /// The GNSS outages the motion file adds (none without one).
+    pub fn motion_outages(&self) -> Vec<Interval> {
+        let Some(def) = &self.imported else {
+            return Vec::new();
+        };
+        let t0 = self.start.as_ref().map_or(0.0, |s| s.time);
+        def.pieces()
+            .1
+            .iter()
+            .map(|[a, b]| Interval {
+                start: t0 + a,
+                end: t0 + b,
+            })
+            .collect()
+    }
+
+    /// [`ScenarioSpec::trajectory`] without the outages, sending the knots to `feed`
+    /// as they are made.
+    pub fn trajectory_fed<E: EarthModel>(
+        &self,
+        earth: E,
+        feed: Option<KnotFeed>,
+    ) -> Result<SplineTrajectory, ScenarioError> {
         if let Some(def) = &self.imported {
-            let (pieces, outages) = def.pieces();
+            let pieces = def.pieces().0;
             let start = Start {
                 t: self.start.as_ref().map_or(0.0, |s| s.time),
                 pos: def.pos,
@@ -87,24 +113,19 @@ impl ScenarioSpec {
                 attitude: def.attitude,
             };
             let mut b = MotionBuilder::new(earth, &start);
+            if let Some(feed) = feed {
+                b.feed(feed);
+            }
             for (i, p) in pieces.iter().enumerate() {
                 b.push(p).map_err(|source| ScenarioError::Motion {
                     key: format!("motion_csv piece {i}"),
                     source,
                 })?;
             }
-            let traj = b.finish().map_err(|source| ScenarioError::Motion {
+            return b.finish().map_err(|source| ScenarioError::Motion {
                 key: "motion_csv".into(),
                 source,
-            })?;
-            let outages = outages
-                .iter()
-                .map(|[a, b]| Interval {
-                    start: start.t + a,
-                    end: start.t + b,
-                })
-                .collect();
-            return Ok((traj, outages));
+            });
         }
         let start = self.start.clone().ok_or_else(|| ScenarioError::Value {
             key: "start".into(),
@@ -114,7 +135,7 @@ impl ScenarioSpec {
             start,
             motion: self.motion.clone(),
         };
-        Ok((spec.build(earth)?, Vec::new()))
+        spec.build_fed(earth, feed)
     }
 }
 
@@ -288,8 +309,13 @@ struct Sensors {
 impl Sensors {
     /// Measure the exact samples of `block` and add the aiding epochs that fall among
     /// them, each taken at its own exact time.
-    fn measure<E: EarthModel>(&mut self, earth: &E, traj: &SplineTrajectory, block: &mut SimBlock) {
-        let t0 = self.summary.t0;
+    fn measure<E: EarthModel>(
+        &mut self,
+        earth: &E,
+        traj: &SplineTrajectory,
+        t0: f64,
+        block: &mut SimBlock,
+    ) {
         block.gnss.clear();
         block.baro.clear();
         for (i, e) in block.imu.iter_mut().enumerate() {
@@ -383,6 +409,7 @@ impl<S> Turns<S> {
 struct FailGuard<'a, A, B> {
     sensors: &'a Turns<A>,
     writer: &'a Turns<B>,
+    feed: &'a Feed,
     armed: bool,
 }
 
@@ -391,12 +418,113 @@ impl<A, B> Drop for FailGuard<'_, A, B> {
         if self.armed {
             self.sensors.fail();
             self.writer.fail();
+            self.feed.end(None);
+        }
+    }
+}
+
+/// The knots the builder has made so far, shared with the workers.
+#[derive(Default)]
+struct Built {
+    knots: Vec<Knot>,
+    /// Set when the build is over: the trajectory's end time, or `None` if it failed
+    /// (or a worker did: nobody waits any more).
+    end: Option<Option<f64>>,
+}
+
+/// What a worker needs for a block: the knots around its samples, or the news that
+/// the build ended first.
+enum Window {
+    /// The trajectory over the block's samples (the knots covering them; evaluated
+    /// on these, every sample is the same bits as on the whole trajectory).
+    Knots(SplineTrajectory),
+    /// The build is over and ended at this time before the block's last sample.
+    Ended(f64),
+    /// The build failed: stop.
+    Failed,
+}
+
+/// The knots as the builder publishes them ([`super::motion::KnotFeed`]), for the
+/// workers, who start on the first blocks while the rest of the motion is
+/// integrated.
+#[derive(Default)]
+struct Feed {
+    built: Mutex<Built>,
+    more: Condvar,
+}
+
+impl Feed {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Built> {
+        self.built
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    fn push(&self, knots: &[Knot]) {
+        self.lock().knots.extend_from_slice(knots);
+        self.more.notify_all();
+    }
+
+    /// The build is over (`None`: it or a worker failed).
+    fn end(&self, end: Option<f64>) {
+        let mut built = self.lock();
+        if built.end.is_none() {
+            built.end = Some(end);
+        }
+        drop(built);
+        self.more.notify_all();
+    }
+
+    /// The first knot's time, once there is one (`None` if the build failed first).
+    fn start(&self) -> Option<f64> {
+        let mut built = self.lock();
+        loop {
+            if let Some(k) = built.knots.first() {
+                return Some(k.t);
+            }
+            if built.end.is_some() {
+                return None;
+            }
+            built = self
+                .more
+                .wait(built)
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+        }
+    }
+
+    /// The knots covering `[a, b]`: from the last at or before `a` to the first after
+    /// `b` (or the ends), once the builder has gone past `b`; [`Window::Ended`] if
+    /// the trajectory ends before `b`.
+    fn window(&self, a: f64, b: f64) -> Window {
+        let mut built = self.lock();
+        loop {
+            match built.end {
+                Some(None) => return Window::Failed,
+                Some(Some(end)) if b > end => return Window::Ended(end),
+                Some(Some(_)) => break,
+                None if built.knots.last().is_some_and(|k| k.t > b) => break,
+                None => {}
+            }
+            built = self
+                .more
+                .wait(built)
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+        }
+        let knots = &built.knots;
+        let from = knots.partition_point(|k| k.t <= a).saturating_sub(1);
+        let to = knots.partition_point(|k| k.t <= b).min(knots.len() - 1);
+        match SplineTrajectory::new(knots[from..=to].to_vec()) {
+            Ok(traj) => Window::Knots(traj),
+            // The builder's knots always form a trajectory; a failure ends the run.
+            Err(_) => Window::Failed,
         }
     }
 }
 
 impl Run {
-    /// Run `spec` on a given Earth model ([`simulate_with`]).
+    /// Run `spec` on a given Earth model ([`simulate_with`]): the trajectory is
+    /// integrated on its own thread while the workers take the blocks its knots
+    /// already cover.
     fn on<E: EarthModel, T: Default + Send>(
         self,
         earth: E,
@@ -407,13 +535,10 @@ impl Run {
         let imu_model = spec.imu.model()?;
         let mut gnss_model = spec.gnss.as_ref().map(GnssSpec::model).transpose()?;
         let baro_model = spec.baro.as_ref().map(BaroSpec::model).transpose()?;
-        let (traj, motion_outages) = spec.trajectory(earth)?;
         if let Some(g) = gnss_model.as_mut() {
-            g.outages.extend(motion_outages);
+            g.outages.extend(spec.motion_outages());
         }
-        let (t0, t1) = (traj.start(), traj.end());
         let dt = 1.0 / spec.imu.rate_hz;
-        let n = ((t1 - t0) / dt + 1e-9).floor() as u64;
         let sensors = Turns::new(Sensors {
             imu: ImuSimulator::new(imu_model, spec.seed),
             gnss: gnss_model.map(|m| GnssSimulator::new(m, spec.seed)),
@@ -424,37 +549,49 @@ impl Run {
                 imu_samples: 0,
                 gnss_fixes: 0,
                 baro_readings: 0,
-                t0,
-                t1,
+                t0: 0.0,
+                t1: 0.0,
             },
         });
         let writer = Turns::new((write, None::<std::io::Error>));
-        let blocks = (n + 1).div_ceil(self.block);
+        let feed = std::sync::Arc::new(Feed::default());
         let next_block = AtomicU64::new(0);
         let worker = || {
             let mut guard = FailGuard {
                 sensors: &sensors,
                 writer: &writer,
+                feed: &feed,
                 armed: true,
+            };
+            let Some(t0) = feed.start() else {
+                return;
             };
             let (mut block, mut text) = (SimBlock::default(), T::default());
             loop {
                 let k = next_block.fetch_add(1, Ordering::Relaxed);
-                if k >= blocks {
-                    break;
-                }
                 let k0 = k * self.block;
-                super::exact::exact_block(
-                    &earth,
-                    &traj,
-                    t0,
-                    dt,
-                    k0,
-                    (k0 + self.block).min(n + 1),
-                    &mut block.imu,
-                );
+                let mut k1 = k0 + self.block;
+                // Sample k ends at t0 + k dt; the first integrates from the one before.
+                let time = |k: u64| t0 + k as f64 * dt;
+                let traj = match feed.window(time(k0) - dt, time(k1 - 1)) {
+                    Window::Knots(traj) => traj,
+                    Window::Ended(t1) => {
+                        let n = ((t1 - t0) / dt + 1e-9).floor() as u64;
+                        if k0 > n {
+                            break;
+                        }
+                        k1 = k1.min(n + 1);
+                        // The last sample may end up to 1e-9 dt past the end.
+                        match feed.window(time(k0) - dt, time(k1 - 1).min(t1)) {
+                            Window::Knots(traj) => traj,
+                            _ => return,
+                        }
+                    }
+                    Window::Failed => return,
+                };
+                super::exact::exact_block(&earth, &traj, t0, dt, k0, k1, &mut block.imu);
                 if sensors
-                    .take(k, |s| s.measure(&earth, &traj, &mut block))
+                    .take(k, |s| s.measure(&earth, &traj, t0, &mut block))
                     .is_none()
                 {
                     return;
@@ -473,17 +610,30 @@ impl Run {
             }
             guard.armed = false;
         };
-        std::thread::scope(|scope| {
+        let built = std::thread::scope(|scope| {
+            let builder = scope.spawn(|| {
+                let to_workers = std::sync::Arc::clone(&feed);
+                let result =
+                    spec.trajectory_fed(earth, Some(Box::new(move |k| to_workers.push(k))));
+                feed.end(result.as_ref().ok().map(SplineTrajectory::end));
+                result
+            });
             let others: Vec<_> = (1..self.workers).map(|_| scope.spawn(worker)).collect();
             worker();
             for w in others {
                 w.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
             }
+            builder
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e))
         });
+        let traj = built?;
         if let (_, Some(e)) = writer.into_data() {
             return Err(SimError::Io(e));
         }
-        Ok(sensors.into_data().summary)
+        let mut summary = sensors.into_data().summary;
+        (summary.t0, summary.t1) = (traj.start(), traj.end());
+        Ok(summary)
     }
 }
 

@@ -26,7 +26,7 @@
 //! unless the quantity is dimensionless. Errors name the key (`motion[3].bank`) and
 //! why.
 
-use super::motion::{MotionBuilder, MotionError, Piece, Shape, Start, VelocityAxes};
+use super::motion::{KnotFeed, MotionBuilder, MotionError, Piece, Shape, Start, VelocityAxes};
 use super::spline::SplineTrajectory;
 use crate::earth::{EarthModel, Geodetic};
 use crate::rotation::{Euler, wrap_pi};
@@ -839,6 +839,15 @@ fn compile<E: EarthModel>(
 impl MotionSpec {
     /// Compile and integrate the motion on `earth`.
     pub fn build<E: EarthModel>(&self, earth: E) -> Result<SplineTrajectory, ScenarioError> {
+        self.build_fed(earth, None)
+    }
+
+    /// [`MotionSpec::build`], sending the knots to `feed` as they are made.
+    pub fn build_fed<E: EarthModel>(
+        &self,
+        earth: E,
+        feed: Option<KnotFeed>,
+    ) -> Result<SplineTrajectory, ScenarioError> {
         let start = self.start.resolve()?;
         if self.motion.is_empty() {
             return Err(ScenarioError::value(
@@ -847,6 +856,9 @@ impl MotionSpec {
             ));
         }
         let mut b = MotionBuilder::new(earth, &start);
+        if let Some(feed) = feed {
+            b.feed(feed);
+        }
         for (i, seg) in self.motion.iter().enumerate() {
             compile(&mut b, &format!("motion[{i}]"), seg)?;
         }
