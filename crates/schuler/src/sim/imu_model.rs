@@ -231,6 +231,20 @@ impl ImuSimulator {
         )
     }
 
+    /// The errors in effect now as an estimator's sensor-error states hold them: the
+    /// biases ([`ImuSimulator::biases`]) and the scale-factor errors (their asymmetry
+    /// has no such state and is left out).
+    pub fn sensor_errors(&self) -> crate::filter::SensorEstimates {
+        let (gyro_bias, accel_bias) = self.biases();
+        crate::filter::SensorEstimates {
+            gyro_bias,
+            accel_bias,
+            gyro_scale: self.model.gyro.scale,
+            accel_scale: self.model.accel.scale,
+            ..Default::default()
+        }
+    }
+
     /// The measured sample for a true sample.
     pub fn measure(&mut self, truth: &ImuSample) -> ImuSample {
         let dt = truth.dt;

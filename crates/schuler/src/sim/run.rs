@@ -168,6 +168,24 @@ pub struct SimBlock {
     pub gnss: Vec<(usize, GnssFix)>,
     /// Barometer readings after `imu[index]`.
     pub baro: Vec<(usize, BaroReading)>,
+    /// The true IMU errors every [`IMU_ERRORS_INTERVAL`], after `imu[index]`.
+    pub imu_errors: Vec<(usize, ImuErrorTruth)>,
+}
+
+/// Interval of the IMU error truth [s]: the errors change over minutes (bias
+/// instability correlation times of 300 s and more, random walks), so one record a
+/// second shows all of their motion.
+pub const IMU_ERRORS_INTERVAL: f64 = 1.0;
+
+/// The true IMU errors at one instant: the truth of what an estimator's sensor-error
+/// states estimate ([`ImuSimulator::sensor_errors`]), in effect for the IMU sample
+/// that holds `t`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuErrorTruth {
+    /// Time [s].
+    pub t: f64,
+    /// The biases and scale-factor errors.
+    pub errors: crate::filter::SensorEstimates,
 }
 
 /// Receives the simulated streams in time order.
@@ -185,14 +203,22 @@ pub trait SimSink {
     fn gnss(&mut self, fix: &GnssFix) -> std::io::Result<()>;
     /// One barometer reading.
     fn baro(&mut self, reading: &BaroReading) -> std::io::Result<()>;
+    /// The true IMU errors at one instant; ignored by default.
+    fn imu_errors(&mut self, _truth: &ImuErrorTruth) -> std::io::Result<()> {
+        Ok(())
+    }
     /// A block of consecutive epochs; by default one call of [`SimSink::imu`],
     /// [`SimSink::gnss`] and [`SimSink::baro`] per epoch, in time order. A sink that
     /// writes streams to separate files may take the block whole (and format it in
     /// parallel).
     fn block(&mut self, block: &SimBlock) -> std::io::Result<()> {
         let (mut g, mut b) = (block.gnss.iter().peekable(), block.baro.iter().peekable());
+        let mut errors = block.imu_errors.iter().peekable();
         for (i, e) in block.imu.iter().enumerate() {
             self.imu(&e.exact, &e.measured, &e.truth, &e.kin)?;
+            while let Some((_, truth)) = errors.next_if(|(j, _)| *j == i) {
+                self.imu_errors(truth)?;
+            }
             while let Some((_, fix)) = g.next_if(|(j, _)| *j == i) {
                 self.gnss(fix)?;
             }
@@ -244,6 +270,7 @@ pub fn simulate(
             copy.imu.clone_from(&block.imu);
             copy.gnss.clone_from(&block.gnss);
             copy.baro.clone_from(&block.baro);
+            copy.imu_errors.clone_from(&block.imu_errors);
         },
         |copy: &mut SimBlock| sink.block(copy),
     )
@@ -300,9 +327,10 @@ struct Sensors {
     imu: ImuSimulator,
     gnss: Option<GnssSimulator>,
     baro: Option<BaroSimulator>,
-    /// Index of the next GNSS and barometer epoch.
+    /// Index of the next GNSS, barometer and IMU error truth epoch.
     next_gnss: u64,
     next_baro: u64,
+    next_imu_errors: u64,
     summary: SimSummary,
 }
 
@@ -318,9 +346,21 @@ impl Sensors {
     ) {
         block.gnss.clear();
         block.baro.clear();
+        block.imu_errors.clear();
         for (i, e) in block.imu.iter_mut().enumerate() {
             e.measured = self.imu.measure(&e.exact);
             let t = e.exact.t;
+            let imu = &self.imu;
+            emit_epochs(
+                &mut self.next_imu_errors,
+                IMU_ERRORS_INTERVAL,
+                t0,
+                t,
+                |te| {
+                    let errors = imu.sensor_errors();
+                    block.imu_errors.push((i, ImuErrorTruth { t: te, errors }));
+                },
+            );
             if let Some(g) = self.gnss.as_mut() {
                 emit_epochs(&mut self.next_gnss, g.interval(), t0, t, |te| {
                     let (s, kin) = analytic::evaluate(earth, traj, te);
@@ -545,6 +585,7 @@ impl Run {
             baro: baro_model.map(|m| BaroSimulator::new(m, spec.seed)),
             next_gnss: 0,
             next_baro: 0,
+            next_imu_errors: 0,
             summary: SimSummary {
                 imu_samples: 0,
                 gnss_fixes: 0,
@@ -652,6 +693,7 @@ fn emit_epochs(next: &mut u64, interval: f64, t0: f64, t: f64, mut f: impl FnMut
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector3;
 
     const SCENARIO: &str = r#"
 seed = 4
@@ -700,6 +742,64 @@ noise = "0.5 m"
             )
             .expect("simulate");
         (out, summary)
+    }
+
+    /// The IMU error truth: a record each second from the start (in the sample that
+    /// holds it), holding what the samples carry. With a constant bias, turn-on biases
+    /// and scale factors only, the bias is their sum (as drawn) and the scale the
+    /// configured one, and in the sample that holds a record the measured minus exact
+    /// increment is `s x + b dt` for the recorded `b` and `s`; the bias stays within 5
+    /// sigma of the turn-on draw around the constant.
+    #[test]
+    fn imu_error_truth_is_recorded_each_second() {
+        let text = SCENARIO.replace(
+            "preset = \"tactical\"",
+            "gyro = { bias = \"3 deg/h\", turn_on = \"1 deg/h\", scale = \"100 ppm\" }\n\
+             accel = { bias = \"200 ug\", turn_on = \"50 ug\", scale = \"300 ppm\" }",
+        );
+        let spec: ScenarioSpec = toml::from_str(&text).expect("scenario");
+        let mut out: Vec<ImuEpoch> = Vec::new();
+        let mut truth: Vec<(usize, ImuErrorTruth)> = Vec::new();
+        let summary = Run {
+            workers: 2,
+            block: 333,
+        }
+        .on(
+            Wgs84,
+            &spec,
+            |block: &SimBlock, copy: &mut SimBlock| copy.clone_from(block),
+            |copy: &mut SimBlock| {
+                let base = out.len();
+                out.extend_from_slice(&copy.imu);
+                truth.extend(copy.imu_errors.iter().map(|(i, e)| (base + i, *e)));
+                Ok(())
+            },
+        )
+        .expect("simulate");
+        let whole_seconds = (summary.t1 - summary.t0).floor() as usize;
+        assert_eq!(truth.len(), whole_seconds + 1);
+        for (j, (i, e)) in truth.iter().enumerate() {
+            assert_eq!(e.t, summary.t0 + j as f64);
+            let sample = &out[*i];
+            assert!(sample.exact.t - sample.exact.dt < e.t + 1e-9 && e.t <= sample.exact.t + 1e-9);
+            let m = e.errors;
+            assert_eq!(m.gyro_scale, Vector3::repeat(100e-6));
+            assert_eq!(m.accel_scale, Vector3::repeat(300e-6));
+            // Measured minus exact: the scale factor times the input plus bias dt, to
+            // the round-off of the increments (1e-16 of them).
+            let (x, y) = (sample.exact.dtheta, sample.measured.dtheta);
+            let expect = x.component_mul(&m.gyro_scale) + m.gyro_bias * sample.exact.dt;
+            assert!((y - x - expect).norm() < 1e-15 * x.norm().max(1e-6), "{j}");
+            let (x, y) = (sample.exact.dvel, sample.measured.dvel);
+            let expect = x.component_mul(&m.accel_scale) + m.accel_bias * sample.exact.dt;
+            assert!((y - x - expect).norm() < 1e-15 * x.norm(), "{j}");
+        }
+        let b = truth[0].1.errors.gyro_bias;
+        assert!(
+            truth.iter().all(|(_, e)| e.errors.gyro_bias == b),
+            "constant"
+        );
+        assert!(((b.x - 3.0 * crate::units::DEG_PER_H).abs()) < 5.0 * crate::units::DEG_PER_H);
     }
 
     /// The samples do not depend on how the run is split into blocks and workers: the
