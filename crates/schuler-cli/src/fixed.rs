@@ -373,11 +373,11 @@ fn leading_zeros(a: u64, max: usize) -> usize {
 /// range of every number a navigation line holds.
 ///
 /// The integer `n` (rounded as [`push_fixed`] does) is split at `10^8`: the low 8
-/// digits and the at most 7 above them are each made at once in byte lanes. With 8 or
-/// more decimals the low digits are all fraction digits and the point goes among the
-/// high ones; with fewer, the point sits at a constant place in the low digits and the
-/// high ones are written only when there are any. The words are stored where they
-/// belong and overlap, so that no text is shifted twice.
+/// digits and the at most 7 above them are each made at once in byte lanes, the high
+/// ones only when there are any (else their text is a constant). With 8 or more
+/// decimals the low digits are all fraction digits and the point goes among the high
+/// ones; with fewer, the point sits at a constant place in the low digits. The words
+/// are stored where they belong and overlap, so that no text is shifted twice.
 #[inline(always)]
 pub fn put_field<W: Words + ?Sized>(
     out: &mut W,
@@ -394,39 +394,48 @@ pub fn put_field<W: Words + ?Sized>(
     out.sep_then(pos, u64::from(b'-'));
     let mut pos = pos + 1 + usize::from(x.is_sign_negative() && n != 0);
     let (high, low) = (n / 100_000_000, n % 100_000_000);
-    let low = ascii8(low);
     if decimals >= 8 {
         // `high`: the integer digits, then `decimals - 8` fraction digits; at least one
-        // integer digit is kept. `high < 10^7`: at least one leading zero, so the
-        // text with its point fits a word.
+        // integer digit is kept (`high < 10^7`: at least one leading zero). Stored are
+        // those digits, then over the fraction digits the point and them again, then
+        // the low digits.
         let frac_high = decimals - 8;
-        let a = ascii8(high);
-        let lz = leading_zeros(a, 7 - frac_high);
-        let s = a >> (8 * lz);
-        let int_len = 8 - lz - frac_high;
-        let int_mask = (1u64 << (8 * int_len)) - 1;
-        out.put(
-            pos,
-            (s & int_mask) | (u64::from(b'.') << (8 * int_len)) | ((s & !int_mask) << 8),
-        );
-        pos += 9 - lz;
-        out.put(pos, low);
+        if high == 0 {
+            // `0.` and zeros: a constant.
+            out.put(pos, (ZEROS & !0xFF00) | (u64::from(b'.') << 8));
+            pos += 2 + frac_high;
+        } else {
+            let a = ascii8(high);
+            let lz = leading_zeros(a, 7 - frac_high);
+            out.put(pos, a >> (8 * lz));
+            pos += 8 - lz - frac_high;
+            if frac_high > 0 {
+                out.put(pos, u64::from(b'.') | ((a >> (8 * (8 - frac_high))) << 8));
+            } else {
+                out.put(pos, u64::from(b'.'));
+            }
+            pos += 1 + frac_high;
+        }
+        out.put(pos, ascii8(low));
         pos += 8;
     } else {
         // `low`: `8 - decimals` integer digits, then the fraction digits.
         let int_low = 8 - decimals;
-        if high == 0 {
+        let low = if high == 0 {
+            let low = ascii8(low);
             let lz = leading_zeros(low, int_low - 1);
             out.put(pos, low >> (8 * lz));
             pos += int_low - lz;
+            low
         } else {
-            let a = ascii8(high);
+            let (a, low) = (ascii8(high), ascii8(low));
             let lz = leading_zeros(a, 7);
             out.put(pos, a >> (8 * lz));
             pos += 8 - lz;
             out.put(pos, low);
             pos += int_low;
-        }
+            low
+        };
         if decimals > 0 {
             // The point and at most 7 fraction digits: one word.
             out.put(pos, u64::from(b'.') | ((low >> (8 * int_low)) << 8));
