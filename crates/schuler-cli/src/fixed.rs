@@ -334,18 +334,23 @@ fn load4(bytes: &[u8], i: usize) -> u64 {
 
 /// Store `text` at `pos` and return its end: words of 8 bytes, the last one ending at
 /// the text's end (overlapping the one before), or one word assembled from two
-/// overlapping 4-byte halves for a short text. For a number's text (a few dozen bytes
-/// at most) this is a handful of loads and stores where a copy of a variable length
-/// calls `memcpy`.
+/// overlapping 4-byte halves for a short text. For a number's text (at most 24 bytes
+/// from zmij) this is a handful of loads and stores, no loop, where a copy of a
+/// variable length calls `memcpy`.
 #[inline(always)]
 pub fn put_bytes<W: Words + ?Sized>(out: &mut W, pos: usize, text: &[u8]) -> usize {
     let n = text.len();
-    if n >= 8 {
-        let mut i = 0;
+    if n >= 16 {
+        out.put(pos, load8(text, 0));
+        out.put(pos + 8, load8(text, 8));
+        let mut i = 16;
         while i + 8 < n {
             out.put(pos + i, load8(text, i));
             i += 8;
         }
+        out.put(pos + n - 8, load8(text, n - 8));
+    } else if n >= 8 {
+        out.put(pos, load8(text, 0));
         out.put(pos + n - 8, load8(text, n - 8));
     } else if n >= 4 {
         // The bytes both halves hold are the same, so or-ing them is harmless.
