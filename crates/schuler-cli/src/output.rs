@@ -168,11 +168,11 @@ pub fn put_nav_fields<W: Words + ?Sized>(
     e: &Euler,
 ) -> Option<usize> {
     // push_nav_fields takes `e` when `s.normalized() == *s`: latitude within
-    // [-90, 90] deg and no NaN anywhere (NaN != NaN). A sum of every component is NaN
-    // when one is (or on inf - inf, which only sends the row the other way).
-    let (p, v, q) = (&s.pos, &s.v_n, &s.q_bn);
-    let sum = s.t + p.lat + p.lon + p.h + v.x + v.y + v.z + q.i + q.j + q.k + q.w;
-    if !(-FRAC_PI_2..=FRAC_PI_2).contains(&p.lat) || sum.is_nan() {
+    // [-90, 90] deg and no NaN anywhere (NaN != NaN). A NaN in a printed field makes
+    // `put` decline the row; the time and the quaternion are not printed: their sum is
+    // NaN when one of them is (or on inf - inf, which only sends the row the other way).
+    let q = &s.q_bn;
+    if !(-FRAC_PI_2..=FRAC_PI_2).contains(&s.pos.lat) || (s.t + q.i + q.j + q.k + q.w).is_nan() {
         return None;
     }
     Row::with_euler(s, e).put(out, pos)
@@ -420,13 +420,18 @@ pub fn put_imu_increments<W: Words + ?Sized>(
     s: &ImuSample,
     num: &mut zmij::Buffer,
 ) -> usize {
-    let (a, v) = (s.dtheta, s.dvel);
-    let mut pos = pos;
-    for x in [a.x, a.y, a.z, v.x, v.y, v.z] {
+    // One call per field (not a loop over an array of them).
+    let mut field = |pos: usize, x: f64| {
         out.sep(pos);
-        pos = put_bytes(out, pos + 1, num.format(x).as_bytes());
-    }
-    pos
+        put_bytes(out, pos + 1, num.format(x).as_bytes())
+    };
+    let (a, v) = (s.dtheta, s.dvel);
+    let pos = field(pos, a.x);
+    let pos = field(pos, a.y);
+    let pos = field(pos, a.z);
+    let pos = field(pos, v.x);
+    let pos = field(pos, v.y);
+    field(pos, v.z)
 }
 
 /// Write samples as a KF-GINS IMU text file: `t dtheta_xyz dvel_xyz`, time to 1e-9 s
