@@ -130,13 +130,6 @@ impl Text {
         &mut self.bytes[self.len..self.len + room]
     }
 
-    /// A window of `N` bytes of scratch after the text and `skip` bytes more.
-    #[inline(always)]
-    fn window<const N: usize>(&mut self, skip: usize) -> (&mut [u8], &mut [u8; N]) {
-        let (head, window) = self.scratch(skip + N).split_at_mut(skip);
-        (head, window.try_into().expect("N bytes"))
-    }
-
     /// Count `n` bytes of the scratch as text.
     #[inline(always)]
     fn advance(&mut self, n: usize) {
@@ -169,43 +162,75 @@ fn epoch_lines(
     csv: &mut Text,
 ) {
     let (mut time, mut num) = (zmij::Buffer::new(), zmij::Buffer::new());
-    for e in epochs {
-        let t = time.format(e.measured.t).as_bytes();
-        let mut w = Twin(
-            Line {
-                bytes: imu_txt.window::<IMU_WINDOW>(0).1,
-                sep: b' ',
-            },
-            Line {
-                bytes: imu_csv.window::<IMU_WINDOW>(0).1,
-                sep: b',',
-            },
-        );
-        let end = put_bytes(&mut w, 0, t);
-        let end = put_imu_increments(&mut w, end, &e.measured, &mut num);
-        w.put(end, u64::from(b'\n'));
-        let len = Line::<IMU_WINDOW>::end(end) + 1;
-        imu_txt.advance(len);
-        imu_csv.advance(len);
+    let mut rest = epochs;
+    while !rest.is_empty() {
+        // The scratch of every line left, taken once: a line's window is a slice of it
+        // at a position kept in a register.
+        let lines = rest.len();
+        let imu_txt_scratch = imu_txt.scratch(lines * IMU_WINDOW);
+        let imu_csv_scratch = imu_csv.scratch(lines * IMU_WINDOW);
+        let nav_scratch = nav.scratch(lines * (2 + NAV_WINDOW));
+        let csv_scratch = csv.scratch(lines * CSV_WINDOW);
+        let (mut imu_len, mut nav_len, mut csv_len) = (0, 0, 0);
+        let mut declined = None;
+        for (k, e) in rest.iter().enumerate() {
+            let t = time.format(e.measured.t).as_bytes();
+            let mut w = Twin(
+                Line {
+                    bytes: window::<IMU_WINDOW>(imu_txt_scratch, imu_len),
+                    sep: b' ',
+                },
+                Line {
+                    bytes: window::<IMU_WINDOW>(imu_csv_scratch, imu_len),
+                    sep: b',',
+                },
+            );
+            let end = put_bytes(&mut w, 0, t);
+            let end = put_imu_increments(&mut w, end, &e.measured, &mut num);
+            w.put(end, u64::from(b'\n'));
+            imu_len += Line::<IMU_WINDOW>::end(end) + 1;
 
-        let t = if e.truth.t.to_bits() == e.measured.t.to_bits() {
-            t
-        } else {
-            num.format(e.truth.t).as_bytes()
-        };
-        let (week, nav_window) = nav.window::<NAV_WINDOW>(2);
-        week.copy_from_slice(b"0 ");
-        let csv_window = csv.window::<CSV_WINDOW>(0).1;
-        if let Some((nav_len, csv_len)) = truth_line(e, t, nav_window, csv_window) {
-            nav.advance(2 + nav_len);
-            csv.advance(csv_len);
-        } else {
-            let (mut nav_line, mut csv_line) = (Vec::new(), Vec::new());
-            truth_line_general(e, t, &mut nav_line, &mut csv_line);
-            nav.extend(&nav_line);
-            csv.extend(&csv_line);
+            let t = if e.truth.t.to_bits() == e.measured.t.to_bits() {
+                t
+            } else {
+                num.format(e.truth.t).as_bytes()
+            };
+            let (week, nav_window) = nav_scratch[nav_len..].split_at_mut(2);
+            week.copy_from_slice(b"0 ");
+            let lengths = truth_line(e, t, window(nav_window, 0), window(csv_scratch, csv_len));
+            let Some((nav_line, csv_line)) = lengths else {
+                declined = Some(k);
+                break;
+            };
+            nav_len += 2 + nav_line;
+            csv_len += csv_line;
         }
+        imu_txt.advance(imu_len);
+        imu_csv.advance(imu_len);
+        nav.advance(nav_len);
+        csv.advance(csv_len);
+        let Some(k) = declined else {
+            break;
+        };
+        // The truth lines of this epoch through the Vec writers.
+        let e = &rest[k];
+        let (mut nav_line, mut csv_line) = (Vec::new(), Vec::new());
+        truth_line_general(
+            e,
+            num.format(e.truth.t).as_bytes(),
+            &mut nav_line,
+            &mut csv_line,
+        );
+        nav.extend(&nav_line);
+        csv.extend(&csv_line);
+        rest = &rest[k + 1..];
     }
+}
+
+/// The `N` bytes of `scratch` from `at`.
+#[inline(always)]
+fn window<const N: usize>(scratch: &mut [u8], at: usize) -> &mut [u8; N] {
+    (&mut scratch[at..at + N]).try_into().expect("N bytes")
 }
 
 /// The `truth.nav` line of `e` after its week and the `truth.csv` line, with time
