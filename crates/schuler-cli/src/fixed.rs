@@ -395,9 +395,10 @@ pub fn put_field<W: Words + ?Sized>(
     }
     let n = scaled_below_1e15(x, decimals)?;
     // The separator and a minus sign, which counts for a negative number that does not
-    // round to zero.
+    // round to zero: the sign bit of `x` where `n - 1` (wrapping) has none, `n != 0`.
     out.sep_then(pos, u64::from(b'-'));
-    let mut pos = pos + 1 + usize::from(x.is_sign_negative() && n != 0);
+    let minus = (x.to_bits() & !n.wrapping_sub(1)) >> 63;
+    let mut pos = pos + 1 + minus as usize;
     let (high, low) = (n / 100_000_000, n % 100_000_000);
     if decimals >= 8 {
         // `high`: the integer digits, then `decimals - 8` fraction digits; at least one
