@@ -546,6 +546,13 @@ mod tests {
                     }
                 }
             }
+            // The last digits alone.
+            for k in 0..=20 {
+                let x = f64::from(k) / pow as f64;
+                for x in [x, -x] {
+                    assert_eq!(field(x, d), Some(std_text(x, d)), "{x} {d}");
+                }
+            }
             // Every length of the integer part, at the largest value of each.
             for &p in &POW10[..15] {
                 let x = (p as f64 - 1.0) / pow as f64;
