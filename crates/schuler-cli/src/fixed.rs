@@ -14,6 +14,14 @@
 //! once, so a number costs a few dozen instructions, no call and no reload. Values of
 //! 10^15 and more after scaling take a digit loop; beyond `u64`, more than 19 decimals
 //! and NaN or infinity go through std's formatter.
+//!
+//! Lines in bulk (`schuler simulate`, a few hundred numbers per IMU sample) go through
+//! [`put_field`] and [`put_bytes`] instead of [`push_fixed`] and `Vec` pushes: each
+//! line is stored in whole 8-byte words into a fixed-size window ([`Line`]; a text
+//! line and its CSV twin in step, [`Twin`]), no capacity check per number, no copy
+//! of variable length; [`put_field`] covers the numbers of a navigation line (below
+//! `10^15` after scaling) and declines the rest, whose line the `Vec` writers then
+//! make. Both write the same bytes (tested against std and each other).
 
 use std::io::Write;
 
@@ -63,8 +71,30 @@ fn scaled(x: f64, decimals: usize) -> Option<u64> {
     scaled_exact(x, pow)
 }
 
+/// [`scaled`] when the result is below `10^15`, else `None`. The rounding to an
+/// integer is the addition of `2^52` (where the spacing of f64s is 1), which leaves the
+/// integer in the low bits: no conversion instruction and its saturation checks.
+#[inline(always)]
+fn scaled_below_1e15(x: f64, decimals: usize) -> Option<u64> {
+    const SHIFT: f64 = (1u64 << 52) as f64;
+    let pow = *POW10.get(decimals)?;
+    let product = x.abs() * pow as f64;
+    // NaN fails the comparison. Below 10^15 - 1 the result is at most 10^15 - 1.
+    if product < 999_999_999_999_999.0 {
+        let rounded = product + SHIFT;
+        // product minus its nearest integer, exactly: in [-0.5, 0.5].
+        let off = product - (rounded - SHIFT);
+        if 0.5 - off.abs() > product * 2.3e-16 {
+            return Some(rounded.to_bits() - SHIFT.to_bits());
+        }
+        return scaled_exact(x, pow);
+    }
+    None
+}
+
 /// `|x| pow` rounded to the nearest integer, ties to even, from the exact `u128`
-/// product (see the module doc).
+/// product (see the module doc). Out of line: near ties only.
+#[inline(never)]
 fn scaled_exact(x: f64, pow: u64) -> Option<u64> {
     let bits = x.to_bits() & !(1u64 << 63);
     let biased = (bits >> 52) as i32;
@@ -97,19 +127,25 @@ fn scaled_exact(x: f64, pow: u64) -> Option<u64> {
     u64::try_from(q + u128::from(up)).ok()
 }
 
+/// ASCII `'0'` in every byte.
+const ZEROS: u64 = 0x3030_3030_3030_3030;
+
 /// The 8 decimal digits of `v < 10^8` as ASCII, the first in the lowest byte (so
 /// `to_le_bytes` gives them in order): both 4-digit halves split into 2-digit and then
 /// 1-digit lanes at once, by multiplications with reciprocals that are exact in these
-/// ranges (`x 10486 >> 20 = x / 100` for `x < 10^4`, `x 103 >> 10 = x / 10` for `x <
-/// 100`), no dependent divisions.
+/// ranges (`v 109951163 >> 40 = v / 10^4` for `v < 10^8`, `x 10486 >> 20 = x / 100`
+/// for `x < 10^4`, `x 103 >> 10 = x / 10` for `x < 100`), no dependent divisions.
+/// Quotient `q` and remainder of `x` go to the low and high half of a lane at once, as
+/// `(x << s) - ((d << s) - 1) q = ((x - d q) << s) + q` (the split of zmij's `to_bcd8`).
 #[inline]
 fn ascii8(v: u64) -> u64 {
-    let halves = (v / 10_000) | ((v % 10_000) << 32);
+    let q = (v * 109_951_163) >> 40;
+    let halves = (v << 32) - ((10_000 << 32) - 1) * q;
     let hundreds = ((halves * 10_486) >> 20) & 0x0000_007F_0000_007F;
-    let pairs = hundreds | ((halves - hundreds * 100) << 16);
+    let pairs = (halves << 16) - ((100 << 16) - 1) * hundreds;
     let tens = ((pairs * 103) >> 10) & 0x000F_000F_000F_000F;
-    let digits = tens | ((pairs - tens * 10) << 8);
-    digits | 0x3030_3030_3030_3030
+    let digits = (pairs << 8) - ((10 << 8) - 1) * tens;
+    digits | ZEROS
 }
 
 /// The 16 decimal digits of `n < 10^16` as ASCII, the first in the lowest byte.
@@ -205,6 +241,224 @@ pub fn push_fixed(out: &mut Vec<u8>, x: f64, decimals: usize) {
     }
 }
 
+/// Byte windows that the line writers store into whole 8-byte words: each word lands
+/// at a position, its bytes past the text's end are scratch that the next word or a
+/// later line overwrites. Stores of constant size need no call and no loop.
+pub trait Words {
+    /// Store the 8 bytes of `word` (the first in the lowest byte) at `pos`.
+    fn put(&mut self, pos: usize, word: u64);
+    /// Store the field separator at `pos`.
+    fn sep(&mut self, pos: usize);
+    /// Store the field separator at `pos` and the 7 lowest bytes of `word` after it.
+    fn sep_then(&mut self, pos: usize, word: u64);
+}
+
+/// One line's window of `N` bytes and its field separator. A line holds at most `N -
+/// 8` bytes (a power of two): positions are taken modulo that, so that a store needs
+/// no bounds check, and the writer checks the line's end once ([`Line::end`]).
+pub struct Line<'a, const N: usize> {
+    /// The window.
+    pub bytes: &'a mut [u8; N],
+    /// Field separator (b' ' or b',').
+    pub sep: u8,
+}
+
+impl<const N: usize> Line<'_, N> {
+    /// Positions modulo the longest line.
+    const MASK: usize = {
+        assert!(N > 8 && (N - 8).is_power_of_two());
+        N - 9
+    };
+
+    /// The line's length `end` after checking it: a line longer than the window would
+    /// have wrapped around.
+    #[inline(always)]
+    pub fn end(end: usize) -> usize {
+        assert!(
+            end <= Self::MASK,
+            "a line of {end} bytes overflows its window"
+        );
+        end
+    }
+}
+
+impl<const N: usize> Words for Line<'_, N> {
+    #[inline(always)]
+    fn put(&mut self, pos: usize, word: u64) {
+        let p = pos & Self::MASK;
+        self.bytes[p..p + 8].copy_from_slice(&word.to_le_bytes());
+    }
+
+    #[inline(always)]
+    fn sep(&mut self, pos: usize) {
+        self.bytes[pos & Self::MASK] = self.sep;
+    }
+
+    #[inline(always)]
+    fn sep_then(&mut self, pos: usize, word: u64) {
+        self.put(pos, u64::from(self.sep) | (word << 8));
+    }
+}
+
+/// Two lines written in step, the same text at the same positions, each with its own
+/// separator: a text file's line and its CSV twin, formatted once.
+pub struct Twin<'a, const A: usize, const B: usize>(pub Line<'a, A>, pub Line<'a, B>);
+
+impl<const A: usize, const B: usize> Words for Twin<'_, A, B> {
+    #[inline(always)]
+    fn put(&mut self, pos: usize, word: u64) {
+        self.0.put(pos, word);
+        self.1.put(pos, word);
+    }
+
+    #[inline(always)]
+    fn sep(&mut self, pos: usize) {
+        self.0.sep(pos);
+        self.1.sep(pos);
+    }
+
+    #[inline(always)]
+    fn sep_then(&mut self, pos: usize, word: u64) {
+        self.0.sep_then(pos, word);
+        self.1.sep_then(pos, word);
+    }
+}
+
+/// The little-endian word of `bytes[i..i + 8]`.
+#[inline(always)]
+fn load8(bytes: &[u8], i: usize) -> u64 {
+    let mut w = [0u8; 8];
+    w.copy_from_slice(&bytes[i..i + 8]);
+    u64::from_le_bytes(w)
+}
+
+/// The little-endian word of `bytes[i..i + 4]`.
+#[inline(always)]
+fn load4(bytes: &[u8], i: usize) -> u64 {
+    let mut w = [0u8; 4];
+    w.copy_from_slice(&bytes[i..i + 4]);
+    u64::from(u32::from_le_bytes(w))
+}
+
+/// Store `text` at `pos` and return its end: words of 8 bytes, the last one ending at
+/// the text's end (overlapping the one before), or one word assembled from two
+/// overlapping 4-byte halves for a short text. For a number's text (at most 24 bytes
+/// from zmij) this is a handful of loads and stores, no loop, where a copy of a
+/// variable length calls `memcpy`.
+#[inline(always)]
+pub fn put_bytes<W: Words + ?Sized>(out: &mut W, pos: usize, text: &[u8]) -> usize {
+    let n = text.len();
+    if n >= 16 {
+        out.put(pos, load8(text, 0));
+        out.put(pos + 8, load8(text, 8));
+        let mut i = 16;
+        while i + 8 < n {
+            out.put(pos + i, load8(text, i));
+            i += 8;
+        }
+        out.put(pos + n - 8, load8(text, n - 8));
+    } else if n >= 8 {
+        out.put(pos, load8(text, 0));
+        out.put(pos + n - 8, load8(text, n - 8));
+    } else if n >= 4 {
+        // The bytes both halves hold are the same, so or-ing them is harmless.
+        out.put(pos, load4(text, 0) | (load4(text, n - 4) << (8 * (n - 4))));
+    } else {
+        let mut w = 0;
+        for (i, &b) in text.iter().enumerate() {
+            w |= u64::from(b) << (8 * i);
+        }
+        out.put(pos, w);
+    }
+    pos + n
+}
+
+/// Leading zero digits of the 8 ASCII digits `a` (first in the lowest byte), at most
+/// `max`.
+#[inline(always)]
+fn leading_zeros(a: u64, max: usize) -> usize {
+    (((a ^ ZEROS).trailing_zeros() / 8) as usize).min(max)
+}
+
+/// Store the field separator at `pos`, then `x` with exactly `decimals` digits after
+/// the point, the text of [`push_fixed`], and return the end; `None` (and scratch
+/// written) unless `x` is finite, `decimals <= 14` and `|x| 10^decimals < 10^15`, the
+/// range of every number a navigation line holds.
+///
+/// The integer `n` (rounded as [`push_fixed`] does) is split at `10^8`: the low 8
+/// digits and the at most 7 above them are each made at once in byte lanes, the high
+/// ones only when there are any (else their text is a constant). With 8 or more
+/// decimals the low digits are all fraction digits and the point goes among the high
+/// ones; with fewer, the point sits at a constant place in the low digits. The words
+/// are stored where they belong and overlap, so that no text is shifted twice.
+#[inline(always)]
+pub fn put_field<W: Words + ?Sized>(
+    out: &mut W,
+    pos: usize,
+    x: f64,
+    decimals: usize,
+) -> Option<usize> {
+    if decimals > 14 {
+        return None;
+    }
+    let n = scaled_below_1e15(x, decimals)?;
+    // The separator and a minus sign, which counts for a negative number that does not
+    // round to zero: the sign bit of `x` where `n - 1` (wrapping) has none, `n != 0`.
+    out.sep_then(pos, u64::from(b'-'));
+    let minus = (x.to_bits() & !n.wrapping_sub(1)) >> 63;
+    let mut pos = pos + 1 + minus as usize;
+    let (high, low) = (n / 100_000_000, n % 100_000_000);
+    if decimals >= 8 {
+        // `high`: the integer digits, then `decimals - 8` fraction digits; at least one
+        // integer digit is kept (`high < 10^7`: at least one leading zero). Stored are
+        // those digits, then over the fraction digits the point and them again, then
+        // the low digits.
+        let frac_high = decimals - 8;
+        if high == 0 {
+            // `0.` and zeros: a constant.
+            out.put(pos, (ZEROS & !0xFF00) | (u64::from(b'.') << 8));
+            pos += 2 + frac_high;
+        } else {
+            let a = ascii8(high);
+            let lz = leading_zeros(a, 7 - frac_high);
+            out.put(pos, a >> (8 * lz));
+            pos += 8 - lz - frac_high;
+            if frac_high > 0 {
+                out.put(pos, u64::from(b'.') | ((a >> (8 * (8 - frac_high))) << 8));
+            } else {
+                out.put(pos, u64::from(b'.'));
+            }
+            pos += 1 + frac_high;
+        }
+        out.put(pos, ascii8(low));
+        pos += 8;
+    } else {
+        // `low`: `8 - decimals` integer digits, then the fraction digits.
+        let int_low = 8 - decimals;
+        let low = if high == 0 {
+            let low = ascii8(low);
+            let lz = leading_zeros(low, int_low - 1);
+            out.put(pos, low >> (8 * lz));
+            pos += int_low - lz;
+            low
+        } else {
+            let (a, low) = (ascii8(high), ascii8(low));
+            let lz = leading_zeros(a, 7);
+            out.put(pos, a >> (8 * lz));
+            pos += 8 - lz;
+            out.put(pos, low);
+            pos += int_low;
+            low
+        };
+        if decimals > 0 {
+            // The point and at most 7 fraction digits: one word.
+            out.put(pos, u64::from(b'.') | ((low >> (8 * int_low)) << 8));
+            pos += decimals + 1;
+        }
+    }
+    Some(pos)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,6 +477,142 @@ mod tests {
             Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
             _ => s,
         }
+    }
+
+    /// [`put_field`]'s text after its separator, `None` outside its range. The window
+    /// starts with other text and has old bytes after the end, as a block's scratch.
+    fn field(x: f64, d: usize) -> Option<String> {
+        let mut bytes = [b'#'; 72];
+        let mut line = Line {
+            bytes: &mut bytes,
+            sep: b',',
+        };
+        let end = Line::<72>::end(put_field(&mut line, 3, x, d)?);
+        assert_eq!(&bytes[..4], b"###,");
+        Some(String::from_utf8(bytes[4..end].to_vec()).expect("ascii"))
+    }
+
+    /// Whether `x` with `d` decimals is within [`put_field`]'s range (with a margin at
+    /// its edge, where the floating-point product decides).
+    fn in_range(x: f64, d: usize) -> bool {
+        x.is_finite() && d <= 14 && x.abs() * POW10[d] as f64 <= 9.99e14
+    }
+
+    /// The reciprocal that splits 8 digits into 4 and 4 is exact for every 8-digit
+    /// number, and so are those for 4 and 2 digits in their ranges.
+    #[test]
+    fn digit_split_reciprocals_are_exact() {
+        for v in 0..100_000_000u64 {
+            assert_eq!((v * 109_951_163) >> 40, v / 10_000, "{v}");
+        }
+        for x in 0..10_000u64 {
+            assert_eq!((x * 10_486) >> 20, x / 100, "{x}");
+        }
+        for x in 0..100u64 {
+            assert_eq!((x * 103) >> 10, x / 10, "{x}");
+        }
+    }
+
+    /// [`put_field`] against std and [`push_fixed`] at every decimal count it takes,
+    /// on the numbers of a navigation line and around every change of length.
+    #[test]
+    fn fields_examples() {
+        for (d, &pow) in POW10.iter().enumerate().take(15) {
+            for x in [
+                0.0,
+                -0.0,
+                1.0,
+                -1.0,
+                0.5,
+                -0.5,
+                45.07123456789,
+                -179.99999999999,
+                7.0,
+                359.999999999,
+                -9.80665,
+                30.000000,
+                1e-300,
+                -5e-324,
+                f64::MIN_POSITIVE,
+            ] {
+                for scale in [1.0, 10.0, 1e3, 1e5, 1e7, 1e-3, 1e-7] {
+                    let x = x * scale;
+                    match field(x, d) {
+                        Some(text) => {
+                            assert_eq!(text, std_text(x, d), "{x} {d}");
+                            assert_eq!(text, fixed(x, d), "{x} {d}");
+                        }
+                        None => assert!(!in_range(x, d), "{x} {d}"),
+                    }
+                }
+            }
+            // The last digits alone.
+            for k in 0..=20 {
+                let x = f64::from(k) / pow as f64;
+                for x in [x, -x] {
+                    assert_eq!(field(x, d), Some(std_text(x, d)), "{x} {d}");
+                }
+            }
+            // Every length of the integer part, at the largest value of each.
+            for &p in &POW10[..15] {
+                let x = (p as f64 - 1.0) / pow as f64;
+                if let Some(text) = field(x, d) {
+                    assert_eq!(text, std_text(x, d), "{x} {d}");
+                }
+                if let Some(text) = field(-x, d) {
+                    assert_eq!(text, std_text(-x, d), "{x} {d}");
+                }
+            }
+        }
+        for x in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300] {
+            assert_eq!(field(x, 6), None);
+        }
+        assert_eq!(field(1.0, 15), None);
+    }
+
+    /// [`put_bytes`] stores any text of any length, the bytes around it untouched.
+    #[test]
+    fn bytes_of_every_length() {
+        let text: Vec<u8> = (0..40u8).map(|i| b'a' + i % 26).collect();
+        for n in 0..=text.len() {
+            let mut bytes = [b'#'; 72];
+            let mut line = Line {
+                bytes: &mut bytes,
+                sep: b' ',
+            };
+            let end = put_bytes(&mut line, 5, &text[..n]);
+            assert_eq!(end, 5 + n);
+            assert_eq!(&bytes[..5], b"#####");
+            assert_eq!(&bytes[5..end], &text[..n]);
+        }
+    }
+
+    /// Both lines of a twin hold the same text, each with its separator.
+    #[test]
+    fn twin_lines() {
+        let (mut a, mut b) = ([0u8; 72], [0u8; 136]);
+        let mut w = Twin(
+            Line {
+                bytes: &mut a,
+                sep: b' ',
+            },
+            Line {
+                bytes: &mut b,
+                sep: b',',
+            },
+        );
+        let end = put_bytes(&mut w, 0, b"0.25");
+        let end = put_field(&mut w, end, -1.5, 3).expect("in range");
+        let end = put_field(&mut w, end, 2e-7, 6).expect("in range");
+        assert_eq!(&a[..end], b"0.25 -1.500 0.000000");
+        assert_eq!(&b[..end], b"0.25,-1.500,0.000000");
+    }
+
+    /// A line longer than its window is refused, not wrapped around.
+    #[test]
+    #[should_panic(expected = "overflows its window")]
+    fn line_longer_than_window() {
+        Line::<72>::end(65);
     }
 
     /// The digit lanes against the plain text of every kind of number: zeros inside,
@@ -307,6 +697,40 @@ mod tests {
             let tie = (k as f64 + 0.5) / POW10[d] as f64;
             let x = f64::from_bits(tie.to_bits().wrapping_add_signed(ulps));
             prop_assert_eq!(fixed(x, d), std_text(x, d));
+        }
+
+        /// [`put_field`]: std's text wherever it is in range, and in range for every
+        /// number of a navigation line.
+        #[test]
+        fn fields_agree_with_std(x in -1e7..1e7f64, d in 0usize..=14) {
+            match field(x, d) {
+                Some(text) => prop_assert_eq!(text, std_text(x, d)),
+                None => prop_assert!(!in_range(x, d)),
+            }
+        }
+
+        /// The same for any bit pattern, NaN and infinities included.
+        #[test]
+        fn fields_agree_with_std_on_any_bits(bits in any::<u64>(), d in 0usize..=16) {
+            let x = f64::from_bits(bits);
+            match field(x, d) {
+                Some(text) => prop_assert_eq!(text, std_text(x, d)),
+                None => prop_assert!(!in_range(x, d)),
+            }
+        }
+
+        /// A few ulps around decimal ties, where the exact product decides.
+        #[test]
+        fn fields_near_ties_agree_with_std(
+            k in 0u64..1_000_000_000_000_000,
+            d in 1usize..=14,
+            ulps in -4i64..=4,
+        ) {
+            let tie = (k as f64 + 0.5) / POW10[d] as f64;
+            let x = f64::from_bits(tie.to_bits().wrapping_add_signed(ulps));
+            if let Some(text) = field(x, d) {
+                prop_assert_eq!(text, std_text(x, d));
+            }
         }
     }
 }

@@ -25,6 +25,8 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 pub use crate::fixed::push_fixed;
+use crate::fixed::{Words, put_bytes, put_field};
+use std::f64::consts::FRAC_PI_2;
 
 /// Longitude (or any angle) [rad] in degrees, wrapped to (-180, 180]
 /// ([`schuler::rotation::wrap_pi`]).
@@ -49,6 +51,23 @@ fn printable_heading(y: f64, decimals: i32) -> f64 {
         0.0
     } else {
         y
+    }
+}
+
+/// [`Euler::heading_0_2pi`], the same bits, without its `fmod` for a yaw within one
+/// turn (where `yaw % 2π` is `yaw` exactly and `rem_euclid` adds 2π to a negative
+/// one).
+#[inline(always)]
+fn heading_0_2pi(e: &Euler) -> f64 {
+    use std::f64::consts::TAU;
+    let yaw = e.yaw;
+    if (0.0..TAU).contains(&yaw) {
+        yaw
+    } else if yaw > -TAU && yaw < 0.0 {
+        let y = yaw + TAU;
+        if y >= TAU { 0.0 } else { y }
+    } else {
+        e.heading_0_2pi()
     }
 }
 
@@ -78,7 +97,7 @@ impl Row {
             v: [s.v_n.x, s.v_n.y, s.v_n.z],
             roll_deg: e.roll.to_degrees(),
             pitch_deg: e.pitch.to_degrees(),
-            yaw_deg: printable_heading(e.heading_0_2pi().to_degrees(), 9),
+            yaw_deg: printable_heading(heading_0_2pi(e).to_degrees(), 9),
         }
     }
 
@@ -102,6 +121,24 @@ impl Row {
         field(self.pitch_deg, 9);
         field(self.yaw_deg, 9);
     }
+
+    /// [`Row::push`] into words at `pos`: the same bytes, each field preceded by the
+    /// separator; returns the end, or `None` when a field is outside
+    /// [`put_field`]'s range (then [`Row::push`] writes the row).
+    #[inline(always)]
+    fn put<W: Words + ?Sized>(&self, out: &mut W, pos: usize) -> Option<usize> {
+        // As in `push`, one call per field with constant decimals.
+        let mut field = |pos: usize, x: f64, decimals: usize| put_field(out, pos, x, decimals);
+        let pos = field(pos, self.lat_deg, 11)?;
+        let pos = field(pos, self.lon_deg, 11)?;
+        let pos = field(pos, self.h, 6)?;
+        let pos = field(pos, self.v[0], 6)?;
+        let pos = field(pos, self.v[1], 6)?;
+        let pos = field(pos, self.v[2], 6)?;
+        let pos = field(pos, self.roll_deg, 9)?;
+        let pos = field(pos, self.pitch_deg, 9)?;
+        field(pos, self.yaw_deg, 9)
+    }
 }
 
 /// Append the columns of a navigation row after its time, each preceded by `sep`:
@@ -118,6 +155,27 @@ pub fn push_nav_fields(out: &mut Vec<u8>, s: &NavState, e: &Euler, sep: u8) {
     } else {
         Row::with_euler(&n, &n.euler()).push(out, sep);
     }
+}
+
+/// [`push_nav_fields`] into words at `pos` (the same bytes, separators from `out`);
+/// returns the end, or `None` when [`push_nav_fields`] must write the row: a field
+/// outside [`put_field`]'s range, a NaN in the state, or a state past a pole.
+#[inline(always)]
+pub fn put_nav_fields<W: Words + ?Sized>(
+    out: &mut W,
+    pos: usize,
+    s: &NavState,
+    e: &Euler,
+) -> Option<usize> {
+    // push_nav_fields takes `e` when `s.normalized() == *s`: latitude within
+    // [-90, 90] deg and no NaN anywhere (NaN != NaN). A NaN in a printed field makes
+    // `put` decline the row; the time and the quaternion are not printed: their sum is
+    // NaN when one of them is (or on inf - inf, which only sends the row the other way).
+    let q = &s.q_bn;
+    if !(-FRAC_PI_2..=FRAC_PI_2).contains(&s.pos.lat) || (s.t + q.i + q.j + q.k + q.w).is_nan() {
+        return None;
+    }
+    Row::with_euler(s, e).put(out, pos)
 }
 
 /// One navigation epoch with the quantities defined everywhere (poles included).
@@ -353,6 +411,29 @@ pub fn push_imu_line(out: &mut Vec<u8>, s: &ImuSample, sep: u8, digits: ImuDigit
     }
 }
 
+/// The increments of [`push_imu_line`]'s [`ImuDigits::Shortest`] line, each preceded
+/// by the separator, into words at `pos`; returns the end. `num` is scratch.
+#[inline(always)]
+pub fn put_imu_increments<W: Words + ?Sized>(
+    out: &mut W,
+    pos: usize,
+    s: &ImuSample,
+    num: &mut zmij::Buffer,
+) -> usize {
+    // One call per field (not a loop over an array of them).
+    let mut field = |pos: usize, x: f64| {
+        out.sep(pos);
+        put_bytes(out, pos + 1, num.format(x).as_bytes())
+    };
+    let (a, v) = (s.dtheta, s.dvel);
+    let pos = field(pos, a.x);
+    let pos = field(pos, a.y);
+    let pos = field(pos, a.z);
+    let pos = field(pos, v.x);
+    let pos = field(pos, v.y);
+    field(pos, v.z)
+}
+
 /// Write samples as a KF-GINS IMU text file: `t dtheta_xyz dvel_xyz`, time to 1e-9 s
 /// and increments in exponent notation with `digits` significant digits (17 round-trip
 /// every f64 exactly; KF-GINS data sets carry about 13); lines from
@@ -379,6 +460,144 @@ pub fn write_imu_text(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixed::{Line, Twin};
+    use proptest::prelude::*;
+    use std::f64::consts::{PI, TAU};
+
+    /// [`put_nav_fields`] and [`put_imu_increments`] into a text and CSV twin, with
+    /// [`push_nav_fields`] and [`push_imu_line`] (the Vec writers) as the oracle: the
+    /// same bytes, or `None` exactly where the Vec writer must take the row.
+    fn twin_text(
+        put: impl FnOnce(&mut Twin<'_, 264, 264>) -> Option<usize>,
+    ) -> Option<[String; 2]> {
+        let (mut a, mut b) = ([b'#'; 264], [b'#'; 264]);
+        let mut w = Twin(
+            Line {
+                bytes: &mut a,
+                sep: b' ',
+            },
+            Line {
+                bytes: &mut b,
+                sep: b',',
+            },
+        );
+        let end = Line::<264>::end(put(&mut w)?);
+        let text = |bytes: &[u8]| String::from_utf8(bytes[..end].to_vec()).expect("ascii");
+        Some([text(&a), text(&b)])
+    }
+
+    fn pushed_nav(s: &NavState, e: &Euler) -> [String; 2] {
+        [b' ', b','].map(|sep| {
+            let mut v = Vec::new();
+            push_nav_fields(&mut v, s, e, sep);
+            String::from_utf8(v).expect("ascii")
+        })
+    }
+
+    fn nav_state(lat_deg: f64, lon_deg: f64, h: f64, v: [f64; 3], e: &Euler) -> NavState {
+        NavState::new(
+            12.5,
+            Geodetic::new(lat_deg.to_radians(), lon_deg.to_radians(), h),
+            Vector3::from(v),
+            *e,
+        )
+    }
+
+    /// The fast heading is [`Euler::heading_0_2pi`], bit for bit, at and around the
+    /// ends of its ranges.
+    #[test]
+    fn heading_without_fmod() {
+        let mut yaws = vec![0.0, -0.0, PI, -PI, TAU, -TAU, 3.0 * PI, -3.0 * PI, 1e-300];
+        for y in [0.0f64, TAU, -TAU, PI, -PI, 1e-17, -1e-17] {
+            for k in 1..4u64 {
+                yaws.push(f64::from_bits(y.to_bits() + k));
+                yaws.push(f64::from_bits(y.to_bits().wrapping_sub(k)));
+            }
+        }
+        yaws.extend([f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
+        for yaw in yaws {
+            let e = Euler::new(0.0, 0.0, yaw);
+            assert_eq!(
+                heading_0_2pi(&e).to_bits(),
+                e.heading_0_2pi().to_bits(),
+                "{yaw:e}"
+            );
+        }
+    }
+
+    /// Rows the fast writer declines (past a pole, NaN, out of its range) and rows it
+    /// writes, at the edges of the printed ranges.
+    #[test]
+    fn nav_fields_examples() {
+        let e = Euler::from_degrees(1.0, -2.0, 359.9999999999);
+        let cases = [
+            nav_state(45.0, 7.0, 300.0, [30.0, 0.0, -0.0], &e),
+            nav_state(-90.0, -180.0 + 1e-13, -0.0, [0.0; 3], &e),
+            nav_state(90.0, 180.0, 1e8, [-1e3, 1e-7, -5e-7], &e),
+            nav_state(91.0, 20.0, 100.0, [1.0, 2.0, 3.0], &e),
+            nav_state(45.0, 7.0, 1e300, [1.0, 2.0, 3.0], &e),
+            nav_state(45.0, 7.0, f64::NAN, [1.0, 2.0, 3.0], &e),
+            nav_state(f64::NAN, 7.0, 1.0, [1.0, 2.0, 3.0], &e),
+            nav_state(45.0, 7.0, 1.0, [f64::INFINITY, 2.0, 3.0], &e),
+        ];
+        let mut written = 0;
+        for s in &cases {
+            let pushed = pushed_nav(s, &e);
+            if let Some(put) = twin_text(|w| put_nav_fields(w, 0, s, &e)) {
+                assert_eq!(put, pushed);
+                written += 1;
+            }
+        }
+        assert_eq!(written, 3);
+        // NaN time: not the same state after normalizing, so `e` is not taken.
+        let mut s = cases[0];
+        s.t = f64::NAN;
+        assert_eq!(twin_text(|w| put_nav_fields(w, 0, &s, &e)), None);
+    }
+
+    proptest! {
+        /// Any state within the range: the Vec writer's bytes; past a pole: declined.
+        #[test]
+        fn nav_fields_agree_with_push(
+            lat_deg in -95.0..95.0f64,
+            lon_deg in -400.0..400.0f64,
+            h in -1e4..1e7f64,
+            v in prop::array::uniform3(-1e3..1e3f64),
+            rpy in prop::array::uniform3(-7.0..7.0f64),
+        ) {
+            let e = Euler::new(rpy[0], rpy[1], rpy[2]);
+            let s = nav_state(lat_deg, lon_deg, h, v, &e);
+            let pushed = pushed_nav(&s, &e);
+            match twin_text(|w| put_nav_fields(w, 0, &s, &e)) {
+                Some(put) => prop_assert_eq!(put, pushed),
+                None => prop_assert!(lat_deg.abs() > 90.0),
+            }
+        }
+
+        /// IMU increments of any bits: the Vec writer's shortest line after the time.
+        #[test]
+        fn imu_increments_agree_with_push(bits in prop::array::uniform6(any::<u64>())) {
+            let x = bits.map(f64::from_bits);
+            let s = ImuSample {
+                t: 0.25,
+                dt: 0.005,
+                dtheta: Vector3::new(x[0], x[1], x[2]),
+                dvel: Vector3::new(x[3], x[4], x[5]),
+            };
+            let mut num = zmij::Buffer::new();
+            let put = twin_text(|w| {
+                let end = put_bytes(w, 0, b"0.25");
+                Some(put_imu_increments(w, end, &s, &mut num))
+            })
+            .expect("always written");
+            let pushed = [b' ', b','].map(|sep| {
+                let mut v = Vec::new();
+                push_imu_line(&mut v, &s, sep, ImuDigits::Shortest);
+                String::from_utf8(v).expect("ascii")
+            });
+            prop_assert_eq!(put, pushed);
+        }
+    }
 
     /// The two IMU line forms: shortest round trip, and fixed significant digits
     /// (what `{:.9}` and `{:.12e}` print).

@@ -25,8 +25,8 @@
 //! ([`schuler::sim::run::simulate_with`]). The same scenario and seed give the same
 //! bytes.
 
-use crate::fixed::push_fixed;
-use crate::output::{ImuDigits, push_imu_line, push_nav_fields};
+use crate::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
+use crate::output::{push_nav_fields, put_imu_increments, put_nav_fields};
 use anyhow::{Context, Result};
 use schuler::sim::receivers::GnssFix;
 use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
@@ -84,50 +84,211 @@ const W_DECIMALS: usize = 12;
 /// Decimals of the true specific force in `truth.csv` (1e-10 m/s^2).
 const F_DECIMALS: usize = 10;
 
-/// `bytes` with every space turned into a comma, appended to `out`.
-fn push_as_csv(out: &mut Vec<u8>, bytes: &[u8]) {
-    let start = out.len();
-    out.extend_from_slice(bytes);
-    // An unconditional store per byte, so the loop runs on vector lanes.
-    for b in &mut out[start..] {
-        *b = if *b == b' ' { b',' } else { *b };
+/// Windows for one line ([`Line`]: the longest line, a power of two, and 8 bytes more):
+/// an IMU line (7 shortest numbers of at most 24 bytes, with separators and newline
+/// 175 bytes), a `truth.nav` line after its `0 ` (the time, 9 fixed-decimal fields of
+/// at most 17 bytes, each with its separator: 188 bytes) and a `truth.csv` line (the
+/// time, 15 such fields: 296 bytes).
+const IMU_WINDOW: usize = 256 + 8;
+const NAV_WINDOW: usize = 256 + 8;
+const CSV_WINDOW: usize = 512 + 8;
+
+/// The text of one file for one block, `bytes[..len]`. The bytes past `len` are
+/// scratch, kept from block to block, that a line is stored into in whole words
+/// ([`crate::fixed::Words`]) before it counts: no capacity check per number, no copy
+/// of the line.
+#[derive(Default)]
+struct Text {
+    bytes: Vec<u8>,
+    len: usize,
+}
+
+impl Text {
+    fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// Make `room` bytes of scratch after the text. An empty text takes fresh zeroed
+    /// memory (pages the system zeroes when first touched, no writes of zeros).
+    #[inline(always)]
+    fn reserve(&mut self, room: usize) {
+        let end = self.len + room;
+        if self.bytes.len() < end {
+            let size = end.max(2 * self.bytes.len());
+            if self.len == 0 {
+                self.bytes = vec![0; size];
+            } else {
+                self.bytes.resize(size, 0);
+            }
+        }
+    }
+
+    /// The first `room` bytes of scratch after the text.
+    #[inline(always)]
+    fn scratch(&mut self, room: usize) -> &mut [u8] {
+        self.reserve(room);
+        &mut self.bytes[self.len..self.len + room]
+    }
+
+    /// Count `n` bytes of the scratch as text.
+    #[inline(always)]
+    fn advance(&mut self, n: usize) {
+        self.len += n;
+        debug_assert!(self.len <= self.bytes.len());
+    }
+
+    /// Append `text`.
+    fn extend(&mut self, text: &[u8]) {
+        self.scratch(text.len()).copy_from_slice(text);
+        self.advance(text.len());
+    }
+
+    fn as_bytes(&self) -> &[u8] {
+        &self.bytes[..self.len]
     }
 }
 
-/// `imu.txt` and `imu.csv` lines of the measured samples of `epochs`. Each number is
-/// formatted once: the CSV line is the same bytes with commas for spaces (no number
-/// contains either).
-fn imu_lines(epochs: &[ImuEpoch], txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
-    let start = txt.len();
-    for e in epochs {
-        push_imu_line(txt, &e.measured, b' ', ImuDigits::Shortest);
-        txt.push(b'\n');
+/// The lines of `epochs` in `imu.txt` and `imu.csv` (`t dtheta_xyz dvel_xyz`, every
+/// number in shortest round-trip form), `truth.nav` (week 0, then `t lat lon h vn ve
+/// vd roll pitch yaw`) and `truth.csv` (the same after the week, then `w_ib_b` and
+/// `f_b`). Each number is formatted once: a CSV line is stored with its text twin
+/// ([`Twin`]), commas for spaces (no number contains either), and the truth's time is
+/// the IMU line's when it is the same f64.
+fn epoch_lines(
+    epochs: &[ImuEpoch],
+    imu_txt: &mut Text,
+    imu_csv: &mut Text,
+    nav: &mut Text,
+    csv: &mut Text,
+) {
+    let (mut time, mut num) = (zmij::Buffer::new(), zmij::Buffer::new());
+    let mut rest = epochs;
+    while !rest.is_empty() {
+        // The scratch of every line left, taken once: a line's window is a slice of it
+        // at a position kept in a register.
+        let lines = rest.len();
+        let imu_txt_scratch = imu_txt.scratch(lines * IMU_WINDOW);
+        let imu_csv_scratch = imu_csv.scratch(lines * IMU_WINDOW);
+        let nav_scratch = nav.scratch(lines * (2 + NAV_WINDOW));
+        let csv_scratch = csv.scratch(lines * CSV_WINDOW);
+        let (mut imu_len, mut nav_len, mut csv_len) = (0, 0, 0);
+        let mut declined = None;
+        for (k, e) in rest.iter().enumerate() {
+            let t = time.format(e.measured.t).as_bytes();
+            let mut w = Twin(
+                Line {
+                    bytes: window::<IMU_WINDOW>(imu_txt_scratch, imu_len),
+                    sep: b' ',
+                },
+                Line {
+                    bytes: window::<IMU_WINDOW>(imu_csv_scratch, imu_len),
+                    sep: b',',
+                },
+            );
+            let end = put_bytes(&mut w, 0, t);
+            let end = put_imu_increments(&mut w, end, &e.measured, &mut num);
+            w.put(end, u64::from(b'\n'));
+            imu_len += Line::<IMU_WINDOW>::end(end) + 1;
+
+            let t = if e.truth.t.to_bits() == e.measured.t.to_bits() {
+                t
+            } else {
+                num.format(e.truth.t).as_bytes()
+            };
+            let (week, nav_window) = nav_scratch[nav_len..].split_at_mut(2);
+            week.copy_from_slice(b"0 ");
+            let lengths = truth_line(e, t, window(nav_window, 0), window(csv_scratch, csv_len));
+            let Some((nav_line, csv_line)) = lengths else {
+                declined = Some(k);
+                break;
+            };
+            nav_len += 2 + nav_line;
+            csv_len += csv_line;
+        }
+        imu_txt.advance(imu_len);
+        imu_csv.advance(imu_len);
+        nav.advance(nav_len);
+        csv.advance(csv_len);
+        let Some(k) = declined else {
+            break;
+        };
+        // The truth lines of this epoch through the Vec writers.
+        let e = &rest[k];
+        let (mut nav_line, mut csv_line) = (Vec::new(), Vec::new());
+        truth_line_general(
+            e,
+            num.format(e.truth.t).as_bytes(),
+            &mut nav_line,
+            &mut csv_line,
+        );
+        nav.extend(&nav_line);
+        csv.extend(&csv_line);
+        rest = &rest[k + 1..];
     }
-    push_as_csv(csv, &txt[start..]);
 }
 
-/// `truth.nav` lines (week 0, then `t lat lon h vn ve vd roll pitch yaw`) and
-/// `truth.csv` lines (the same after the week, then `w_ib_b` and `f_b`) of `epochs`.
-fn truth_lines(epochs: &[ImuEpoch], nav: &mut Vec<u8>, csv: &mut Vec<u8>) {
-    let mut num = zmij::Buffer::new();
-    for e in epochs {
-        nav.extend_from_slice(b"0 ");
-        let start = nav.len();
-        nav.extend_from_slice(num.format(e.truth.t).as_bytes());
-        push_nav_fields(nav, &e.truth, &e.euler, b' ');
-        push_as_csv(csv, &nav[start..]);
-        nav.push(b'\n');
-        let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
-        for x in [w.x, w.y, w.z] {
-            csv.push(b',');
-            push_fixed(csv, x, W_DECIMALS);
-        }
-        for x in [f.x, f.y, f.z] {
-            csv.push(b',');
-            push_fixed(csv, x, F_DECIMALS);
-        }
-        csv.push(b'\n');
+/// The `N` bytes of `scratch` from `at`.
+#[inline(always)]
+fn window<const N: usize>(scratch: &mut [u8], at: usize) -> &mut [u8; N] {
+    (&mut scratch[at..at + N]).try_into().expect("N bytes")
+}
+
+/// The `truth.nav` line of `e` after its week and the `truth.csv` line, with time
+/// text `t`, into the windows `nav` and `csv`; their lengths, or `None` when a number
+/// is outside [`put_nav_fields`]' range (then [`truth_line_general`] writes them).
+#[inline(always)]
+fn truth_line(
+    e: &ImuEpoch,
+    t: &[u8],
+    nav: &mut [u8; NAV_WINDOW],
+    csv: &mut [u8; CSV_WINDOW],
+) -> Option<(usize, usize)> {
+    let mut w = Twin(
+        Line {
+            bytes: nav,
+            sep: b' ',
+        },
+        Line {
+            bytes: csv,
+            sep: b',',
+        },
+    );
+    let end = put_bytes(&mut w, 0, t);
+    let end = put_nav_fields(&mut w, end, &e.truth, &e.euler)?;
+    w.0.put(end, u64::from(b'\n'));
+    let nav_len = Line::<NAV_WINDOW>::end(end) + 1;
+    let mut csv = w.1;
+    let (r, f) = (e.kin.w_ib_b, e.kin.f_b);
+    let mut field = |pos: usize, x: f64, decimals: usize| put_field(&mut csv, pos, x, decimals);
+    let end = field(end, r.x, W_DECIMALS)?;
+    let end = field(end, r.y, W_DECIMALS)?;
+    let end = field(end, r.z, W_DECIMALS)?;
+    let end = field(end, f.x, F_DECIMALS)?;
+    let end = field(end, f.y, F_DECIMALS)?;
+    let end = field(end, f.z, F_DECIMALS)?;
+    csv.put(end, u64::from(b'\n'));
+    Some((nav_len, Line::<CSV_WINDOW>::end(end) + 1))
+}
+
+/// [`truth_line`] for any numbers, whole lines through [`push_nav_fields`] and
+/// [`push_fixed`].
+fn truth_line_general(e: &ImuEpoch, t: &[u8], nav: &mut Vec<u8>, csv: &mut Vec<u8>) {
+    nav.extend_from_slice(b"0 ");
+    nav.extend_from_slice(t);
+    push_nav_fields(nav, &e.truth, &e.euler, b' ');
+    nav.push(b'\n');
+    csv.extend_from_slice(t);
+    push_nav_fields(csv, &e.truth, &e.euler, b',');
+    let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
+    for x in [w.x, w.y, w.z] {
+        csv.push(b',');
+        push_fixed(csv, x, W_DECIMALS);
     }
+    for x in [f.x, f.y, f.z] {
+        csv.push(b',');
+        push_fixed(csv, x, F_DECIMALS);
+    }
+    csv.push(b'\n');
 }
 
 /// Append `xs` in shortest round-trip form separated by `sep`, then a newline.
@@ -170,10 +331,10 @@ fn gnss_lines(fix: &GnssFix, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
 /// to block).
 #[derive(Default)]
 struct BlockText {
-    imu_txt: Vec<u8>,
-    imu_csv: Vec<u8>,
-    truth_nav: Vec<u8>,
-    truth_csv: Vec<u8>,
+    imu_txt: Text,
+    imu_csv: Text,
+    truth_nav: Text,
+    truth_csv: Text,
     gnss_txt: Vec<u8>,
     gnss_csv: Vec<u8>,
     baro_csv: Vec<u8>,
@@ -182,19 +343,30 @@ struct BlockText {
 impl BlockText {
     /// The lines of `block` for every file.
     fn format(&mut self, block: &SimBlock) {
-        for b in [
+        for t in [
             &mut self.imu_txt,
             &mut self.imu_csv,
             &mut self.truth_nav,
             &mut self.truth_csv,
-            &mut self.gnss_txt,
-            &mut self.gnss_csv,
-            &mut self.baro_csv,
         ] {
+            t.clear();
+        }
+        for b in [&mut self.gnss_txt, &mut self.gnss_csv, &mut self.baro_csv] {
             b.clear();
         }
-        imu_lines(&block.imu, &mut self.imu_txt, &mut self.imu_csv);
-        truth_lines(&block.imu, &mut self.truth_nav, &mut self.truth_csv);
+        // Room for the windows of every line: the block's text takes memory once.
+        let lines = block.imu.len();
+        self.imu_txt.reserve(lines * IMU_WINDOW);
+        self.imu_csv.reserve(lines * IMU_WINDOW);
+        self.truth_nav.reserve(lines * (2 + NAV_WINDOW));
+        self.truth_csv.reserve(lines * CSV_WINDOW);
+        epoch_lines(
+            &block.imu,
+            &mut self.imu_txt,
+            &mut self.imu_csv,
+            &mut self.truth_nav,
+            &mut self.truth_csv,
+        );
         for (_, fix) in &block.gnss {
             gnss_lines(fix, &mut self.gnss_txt, &mut self.gnss_csv);
         }
@@ -255,10 +427,10 @@ impl Files {
 
     /// Write a block's text to every file; an error names the file.
     fn write(&mut self, t: &BlockText) -> std::io::Result<()> {
-        self.imu_txt.write_all(&t.imu_txt)?;
-        self.imu_csv.write_all(&t.imu_csv)?;
-        self.truth_nav.write_all(&t.truth_nav)?;
-        self.truth_csv.write_all(&t.truth_csv)?;
+        self.imu_txt.write_all(t.imu_txt.as_bytes())?;
+        self.imu_csv.write_all(t.imu_csv.as_bytes())?;
+        self.truth_nav.write_all(t.truth_nav.as_bytes())?;
+        self.truth_csv.write_all(t.truth_csv.as_bytes())?;
         if let Some((txt, csv)) = self.gnss.as_mut() {
             txt.write_all(&t.gnss_txt)?;
             csv.write_all(&t.gnss_csv)?;
@@ -341,4 +513,218 @@ pub fn run(args: Args) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::{ImuDigits, push_imu_line};
+    use nalgebra::Vector3;
+    use schuler::earth::Geodetic;
+    use schuler::imu::ImuSample;
+    use schuler::nav::NavState;
+    use schuler::rotation::Euler;
+    use schuler::sim::analytic::Kinematics;
+
+    /// The text writers before the fixed-size windows (commit 97e21d9), kept as the
+    /// oracle: every line through the Vec writers, the CSV as the text with commas.
+    mod previous {
+        use super::*;
+
+        fn push_as_csv(out: &mut Vec<u8>, bytes: &[u8]) {
+            let start = out.len();
+            out.extend_from_slice(bytes);
+            for b in &mut out[start..] {
+                *b = if *b == b' ' { b',' } else { *b };
+            }
+        }
+
+        pub fn imu_lines(epochs: &[ImuEpoch], txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
+            let start = txt.len();
+            for e in epochs {
+                push_imu_line(txt, &e.measured, b' ', ImuDigits::Shortest);
+                txt.push(b'\n');
+            }
+            push_as_csv(csv, &txt[start..]);
+        }
+
+        pub fn truth_lines(epochs: &[ImuEpoch], nav: &mut Vec<u8>, csv: &mut Vec<u8>) {
+            let mut num = zmij::Buffer::new();
+            for e in epochs {
+                nav.extend_from_slice(b"0 ");
+                let start = nav.len();
+                nav.extend_from_slice(num.format(e.truth.t).as_bytes());
+                push_nav_fields(nav, &e.truth, &e.euler, b' ');
+                push_as_csv(csv, &nav[start..]);
+                nav.push(b'\n');
+                let (w, f) = (e.kin.w_ib_b, e.kin.f_b);
+                for x in [w.x, w.y, w.z] {
+                    csv.push(b',');
+                    push_fixed(csv, x, W_DECIMALS);
+                }
+                for x in [f.x, f.y, f.z] {
+                    csv.push(b',');
+                    push_fixed(csv, x, F_DECIMALS);
+                }
+                csv.push(b'\n');
+            }
+        }
+    }
+
+    /// The block's text against the previous writers', file by file.
+    fn assert_same_text(block: &SimBlock, text: &BlockText) {
+        let [mut imu_txt, mut imu_csv, mut nav, mut csv] = [(); 4].map(|()| Vec::new());
+        previous::imu_lines(&block.imu, &mut imu_txt, &mut imu_csv);
+        previous::truth_lines(&block.imu, &mut nav, &mut csv);
+        let same = |name: &str, got: &Text, want: &[u8]| {
+            assert!(
+                got.as_bytes() == want,
+                "{name} differs:\n{}\nwanted\n{}",
+                String::from_utf8_lossy(got.as_bytes()),
+                String::from_utf8_lossy(want)
+            );
+        };
+        same("imu.txt", &text.imu_txt, &imu_txt);
+        same("imu.csv", &text.imu_csv, &imu_csv);
+        same("truth.nav", &text.truth_nav, &nav);
+        same("truth.csv", &text.truth_csv, &csv);
+    }
+
+    /// An epoch at time `t` with its numbers taken from `x` in turn (cycled).
+    fn epoch(t: f64, x: &[f64]) -> ImuEpoch {
+        let at = |k: usize| x[k % x.len()];
+        let v3 = |k: usize| Vector3::new(at(k), at(k + 1), at(k + 2));
+        let sample = ImuSample {
+            t,
+            dt: 0.001,
+            dtheta: v3(0),
+            dvel: v3(3),
+        };
+        let euler = Euler::new(at(18), at(19), at(20));
+        ImuEpoch {
+            exact: sample,
+            measured: sample,
+            truth: NavState::new(t, Geodetic::new(at(15), at(16), at(17)), v3(12), euler),
+            kin: Kinematics {
+                w_ib_b: v3(6),
+                f_b: v3(9),
+            },
+            euler,
+        }
+    }
+
+    /// Epochs of every kind: ordinary numbers, signed zeros, the extremes of every
+    /// field's width, values the fast writers decline (NaN, infinities, 1e300, a
+    /// latitude past the pole), a truth time other than the IMU time; the same bytes
+    /// as the previous writers, line by line and as blocks, in scratch with old bytes.
+    #[test]
+    fn same_bytes_as_the_previous_writers() {
+        let ordinary = [
+            std::f64::consts::FRAC_PI_4,
+            0.12217304763960307,
+            300.0,
+            -1.0e-7,
+            29.99999949999,
+            -9.80665,
+            4.9e-6,
+            -0.0,
+            0.0,
+            1.5e-5,
+        ];
+        let wide = [
+            -std::f64::consts::FRAC_PI_2,
+            std::f64::consts::PI,
+            -9999.999999,
+            -1.0 / 3.0,
+        ];
+        let mut epochs = Vec::new();
+        for k in 0..200 {
+            let t = f64::from(k) * 0.001;
+            let mut x = ordinary.to_vec();
+            x.rotate_left(k as usize % ordinary.len());
+            if k % 7 == 0 {
+                x.extend(wide);
+            }
+            epochs.push(epoch(t, &x));
+        }
+        for (k, bad) in [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1e300,
+            -4e15,
+            5e-324,
+            1.6,
+            -1.6,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for j in 0..22 {
+                let mut x = ordinary.to_vec();
+                x[j % ordinary.len()] = bad;
+                let mut e = epoch(1.0 + k as f64, &x);
+                match j {
+                    12..=14 => e.kin.w_ib_b[j - 12] = bad,
+                    15..=17 => e.kin.f_b[j - 15] = bad,
+                    18 => e.truth.pos.lat = bad,
+                    19 => e.truth.pos.h = bad,
+                    20 => e.truth.t = bad,
+                    _ => e.truth.v_n[j % 3] = bad,
+                }
+                epochs.push(e);
+            }
+        }
+        let mut e = epoch(0.1 + 0.2, &ordinary);
+        e.truth.t = 0.3;
+        epochs.push(e);
+
+        let mut text = BlockText::default();
+        for lines in [1, 3, epochs.len()] {
+            for chunk in epochs.chunks(lines) {
+                let block = SimBlock {
+                    imu: chunk.to_vec(),
+                    ..SimBlock::default()
+                };
+                text.format(&block);
+                assert_same_text(&block, &text);
+            }
+        }
+    }
+
+    /// A simulated flight (turn, climb, hold at 1 kHz, a tactical IMU): every block's
+    /// text as the previous writers made it.
+    #[test]
+    fn simulated_blocks_same_bytes_as_the_previous_writers() {
+        let spec: ScenarioSpec = toml::from_str(
+            r#"
+seed = 3
+[start]
+position = ["45 deg", "7 deg", "300 m"]
+attitude = ["0 deg", "0 deg", "0 deg"]
+speed = "30 m/s"
+[[motion]]
+type = "turn"
+angle = "90 deg"
+bank = "20 deg"
+[[motion]]
+type = "climb"
+to_height = "400 m"
+[imu]
+rate_hz = 1000
+preset = "tactical"
+"#,
+        )
+        .expect("scenario");
+        let summary = simulate_with(
+            &spec,
+            |block, text: &mut BlockText| {
+                text.format(block);
+                assert_same_text(block, text);
+            },
+            |_| Ok(()),
+        )
+        .expect("simulated");
+        assert!(summary.imu_samples > 10_000);
+    }
 }
