@@ -114,12 +114,7 @@ impl Table {
 
     fn row(&mut self, t: f64, values: &[f64]) -> Result<()> {
         self.line.clear();
-        push_fixed(&mut self.line, t, 6);
-        for v in values {
-            self.line.push(b' ');
-            push_fixed(&mut self.line, *v, 9);
-        }
-        self.line.push(b'\n');
+        push_table_row(&mut self.line, t, values);
         self.w
             .write_all(&self.line)
             .with_context(|| format!("cannot write {}", self.path.display()))
@@ -200,9 +195,20 @@ fn write_epoch<E: EarthModel, M: AidedMechanization<E>>(
     err.row(state.t, &imu_err_row(&e))
 }
 
+/// A line of `std.txt` or `imu_err.txt`: time to 1 µs, then the values to 9 decimals,
+/// space-separated.
+pub(crate) fn push_table_row(line: &mut Vec<u8>, t: f64, values: &[f64]) {
+    push_fixed(line, t, 6);
+    for v in values {
+        line.push(b' ');
+        push_fixed(line, *v, 9);
+    }
+    line.push(b'\n');
+}
+
 /// The KF-GINS IMU_ERR columns after time: gyro bias [deg/h], accelerometer bias
 /// [mGal], gyro and accelerometer scale factors [ppm].
-fn imu_err_row(e: &schuler::filter::SensorEstimates) -> Vec<f64> {
+pub(crate) fn imu_err_row(e: &schuler::filter::SensorEstimates) -> Vec<f64> {
     let mut row = Vec::with_capacity(12);
     row.extend(e.gyro_bias.iter().map(|x| x / DEG_PER_H));
     row.extend(e.accel_bias.iter().map(|x| x / MGAL));

@@ -18,6 +18,9 @@
 //! - `gnss.txt` (KF-GINS: `t lat lon h std_n std_e std_d`) and `gnss.csv` (adds the
 //!   velocity and its std and the outlier flag);
 //! - `baro.csv` (`t,h_m,outlier`);
+//! - `imu_err_truth.txt`: the true IMU errors once a second in the layout of `schuler
+//!   nav`'s `imu_err.txt` (`t`, gyro bias [deg/h], accelerometer bias [mGal], gyro and
+//!   accelerometer scale factors [ppm]), for `schuler nav --sensor-truth`;
 //! - `scenario.resolved.toml`: every parameter actually used, seed included.
 //!
 //! Blocks of samples are formatted on the simulator's workers, each block while others
@@ -25,6 +28,7 @@
 //! ([`schuler::sim::run::simulate_with`]). The same scenario and seed give the same
 //! bytes.
 
+use super::aided::{imu_err_row, push_table_row};
 use crate::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
 use crate::output::{push_nav_fields, put_imu_increments, put_nav_fields};
 use anyhow::{Context, Result};
@@ -338,6 +342,7 @@ struct BlockText {
     gnss_txt: Vec<u8>,
     gnss_csv: Vec<u8>,
     baro_csv: Vec<u8>,
+    imu_err: Vec<u8>,
 }
 
 impl BlockText {
@@ -351,7 +356,12 @@ impl BlockText {
         ] {
             t.clear();
         }
-        for b in [&mut self.gnss_txt, &mut self.gnss_csv, &mut self.baro_csv] {
+        for b in [
+            &mut self.gnss_txt,
+            &mut self.gnss_csv,
+            &mut self.baro_csv,
+            &mut self.imu_err,
+        ] {
             b.clear();
         }
         // Room for the windows of every line: the block's text takes memory once.
@@ -374,6 +384,9 @@ impl BlockText {
             let row = [r.t, r.h, f64::from(u8::from(r.outlier))];
             push_shortest_line(&mut self.baro_csv, &row, b',');
         }
+        for (_, e) in &block.imu_errors {
+            push_table_row(&mut self.imu_err, e.t, &imu_err_row(&e.errors));
+        }
     }
 }
 
@@ -385,6 +398,7 @@ struct Files {
     truth_csv: Out,
     gnss: Option<(Out, Out)>,
     baro_csv: Option<Out>,
+    imu_err: Out,
 }
 
 impl Files {
@@ -422,6 +436,7 @@ impl Files {
             } else {
                 None
             },
+            imu_err: Out::create(dir, "imu_err_truth.txt")?,
         })
     }
 
@@ -438,11 +453,18 @@ impl Files {
         if let Some(b) = self.baro_csv.as_mut() {
             b.write_all(&t.baro_csv)?;
         }
+        self.imu_err.write_all(&t.imu_err)?;
         Ok(())
     }
 
     fn finish(self) -> Result<()> {
-        for o in [self.imu_txt, self.imu_csv, self.truth_nav, self.truth_csv] {
+        for o in [
+            self.imu_txt,
+            self.imu_csv,
+            self.truth_nav,
+            self.truth_csv,
+            self.imu_err,
+        ] {
             o.finish()?;
         }
         if let Some((a, b)) = self.gnss {
