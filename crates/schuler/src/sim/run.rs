@@ -561,6 +561,15 @@ impl Feed {
     }
 }
 
+/// Ends the feed as failed when dropped, unless it has already ended.
+struct EndsFeed<'a>(&'a Feed);
+
+impl Drop for EndsFeed<'_> {
+    fn drop(&mut self) {
+        self.0.end(None);
+    }
+}
+
 impl Run {
     /// Run `spec` on a given Earth model ([`simulate_with`]): the trajectory is
     /// integrated on its own thread while the workers take the blocks its knots
@@ -653,6 +662,8 @@ impl Run {
         };
         let built = std::thread::scope(|scope| {
             let builder = scope.spawn(|| {
+                // Should the build panic, the workers waiting for its knots are let go.
+                let _ends = EndsFeed(&feed);
                 let to_workers = std::sync::Arc::clone(&feed);
                 let result =
                     spec.trajectory_fed(earth, Some(Box::new(move |k| to_workers.push(k))));
