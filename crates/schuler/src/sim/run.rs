@@ -647,12 +647,17 @@ impl Run {
                     return;
                 }
                 format(&block, &mut text);
-                let written = writer.take(k, |(write, error)| match write(&mut text) {
-                    Ok(()) => true,
-                    Err(e) => {
-                        *error = Some(e);
-                        false
-                    }
+                // After a failed write nothing more is written, even by a worker whose
+                // turn comes before the failed one has released the others.
+                let written = writer.take(k, |(write, error)| {
+                    error.is_none()
+                        && match write(&mut text) {
+                            Ok(()) => true,
+                            Err(e) => {
+                                *error = Some(e);
+                                false
+                            }
+                        }
                 });
                 if written != Some(true) {
                     return;
