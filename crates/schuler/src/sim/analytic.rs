@@ -399,8 +399,25 @@ pub fn increment<E: EarthModel, T: Trajectory + ?Sized>(
 /// one of which is the truth at the sample time.
 const LOBATTO4_INNER: f64 = 0.447_213_595_499_957_9;
 
+/// `∫ w_ib_b` and `∫ f_b` over `[mid - half, mid + half]` by the 4-point
+/// Gauss–Lobatto rule, given the kinematics at both ends and `at`, the kinematics at
+/// any instant inside (called at the two inner nodes).
+pub(crate) fn lobatto4_rule(
+    (mid, half): (f64, f64),
+    (left, right): (&Kinematics, &Kinematics),
+    mut at: impl FnMut(f64) -> Kinematics,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let k1 = at(mid - half * LOBATTO4_INNER);
+    let k2 = at(mid + half * LOBATTO4_INNER);
+    let (w_end, w_inner) = (half / 6.0, half * (5.0 / 6.0));
+    (
+        (left.w_ib_b + right.w_ib_b) * w_end + (k1.w_ib_b + k2.w_ib_b) * w_inner,
+        (left.f_b + right.f_b) * w_end + (k1.f_b + k2.f_b) * w_inner,
+    )
+}
+
 /// `∫ w_ib_b` and `∫ f_b` over the piece of length `2 half` ending at `end`, given the
-/// kinematics at both ends (4-point Gauss–Lobatto).
+/// kinematics at both ends ([`lobatto4_rule`]), added to `dtheta` and `dvel`.
 #[allow(clippy::too_many_arguments)]
 fn lobatto4<E: EarthModel, T: Trajectory + ?Sized>(
     earth: &E,
@@ -412,12 +429,11 @@ fn lobatto4<E: EarthModel, T: Trajectory + ?Sized>(
     dtheta: &mut Vector3<f64>,
     dvel: &mut Vector3<f64>,
 ) {
-    let mid = end - half;
-    let k1 = kinematics(earth, traj, mid - half * LOBATTO4_INNER);
-    let k2 = kinematics(earth, traj, mid + half * LOBATTO4_INNER);
-    let (w_end, w_inner) = (half / 6.0, half * (5.0 / 6.0));
-    *dtheta += (left.w_ib_b + right.w_ib_b) * w_end + (k1.w_ib_b + k2.w_ib_b) * w_inner;
-    *dvel += (left.f_b + right.f_b) * w_end + (k1.f_b + k2.f_b) * w_inner;
+    let (w, f) = lobatto4_rule((end - half, half), (left, right), |t| {
+        kinematics(earth, traj, t)
+    });
+    *dtheta += w;
+    *dvel += f;
 }
 
 /// The exact sample over `(t - dt, t]` and the truth at `t`, given the kinematics at

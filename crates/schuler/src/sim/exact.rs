@@ -22,6 +22,7 @@
 
 use super::analytic::{
     GeodeticEuler, Kinematics, Trig, evaluate_geodetic_with, kinematics_geodetic_with,
+    lobatto4_rule,
 };
 use super::run::ImuEpoch;
 use super::spline::SplineTrajectory;
@@ -49,10 +50,6 @@ static COSINES: LazyLock<[[f64; NODES]; NODES]> = LazyLock::new(|| {
         })
     })
 });
-
-/// Inner nodes `±1/√5` of the 4-point Gauss–Lobatto rule on [-1, 1] (weights 5/6, the
-/// end nodes 1/6).
-const LOBATTO4_INNER: f64 = 0.447_213_595_499_957_9;
 
 /// `w_ib_b` and `f_b` as one array of six.
 fn six(k: &Kinematics) -> [f64; 6] {
@@ -100,7 +97,7 @@ impl Antiderivative {
                 }
             }
         }
-        let floor = [0.0, acceleration_floor(traj, piece)];
+        let floor = [0.0, acceleration_floor(earth, traj, piece)];
         for (triad, floor) in [0..3, 3..6].into_iter().zip(floor) {
             let size = |n: std::ops::Range<usize>, i: usize| -> f64 {
                 coef[n].iter().map(|r| r[i].abs()).sum()
@@ -153,12 +150,12 @@ impl Antiderivative {
 /// and rate differences reach 6 / h^2 and their sum is the speed times `h`): their
 /// round-off, about 1e-16 of this (3e-12 m/s^2 at 40 m/s and 100-Hz knots), is the
 /// floor under which every evaluation of `f_b` scatters, whatever the quadrature.
-fn acceleration_floor(traj: &SplineTrajectory, piece: usize) -> f64 {
+fn acceleration_floor<E: EarthModel>(earth: &E, traj: &SplineTrajectory, piece: usize) -> f64 {
     let times = traj.times();
     let h = times[piece + 1] - times[piece];
     let rate = traj.knots()[piece].rate;
     // Radius: the semi-major axis, generous for a bound.
-    let r = 6_378_137.0;
+    let r = earth.semi_major_axis();
     let speed = ((r * rate[0]).powi(2) + (r * rate[1]).powi(2) + rate[2].powi(2)).sqrt();
     6.0 * speed / h
 }
@@ -258,7 +255,7 @@ fn kinematics_on<E: EarthModel>(
 }
 
 /// `∫ w_ib_b` and `∫ f_b` over `[lo, hi]` on piece `piece` by the 4-point
-/// Gauss–Lobatto rule, given the kinematics at both ends.
+/// Gauss–Lobatto rule ([`lobatto4_rule`]), given the kinematics at both ends.
 fn lobatto<E: EarthModel>(
     earth: &E,
     (traj, piece, base): (&SplineTrajectory, usize, &TrigBase),
@@ -266,23 +263,10 @@ fn lobatto<E: EarthModel>(
     (left, right): (&Kinematics, &Kinematics),
 ) -> [f64; 6] {
     let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-    let k1 = six(&kinematics_on(
-        earth,
-        traj,
-        piece,
-        base,
-        mid - half * LOBATTO4_INNER,
-    ));
-    let k2 = six(&kinematics_on(
-        earth,
-        traj,
-        piece,
-        base,
-        mid + half * LOBATTO4_INNER,
-    ));
-    let (l, r) = (six(left), six(right));
-    let (w_end, w_inner) = (half / 6.0, half * (5.0 / 6.0));
-    std::array::from_fn(|i| (l[i] + r[i]) * w_end + (k1[i] + k2[i]) * w_inner)
+    let (w, f) = lobatto4_rule((mid, half), (left, right), |t| {
+        kinematics_on(earth, traj, piece, base, t)
+    });
+    [w.x, w.y, w.z, f.x, f.y, f.z]
 }
 
 /// Whether piece `piece` is integrated through its Chebyshev fit: when the per-sample
