@@ -16,7 +16,7 @@ use schuler::rotation::Euler;
 
 /// The drive9min truth (100 Hz, 53,000 rows) as text lines.
 fn truth_lines() -> Vec<String> {
-    let bytes = common::unxz(&common::shared_data("drive9min").join("truth.nav.xz"));
+    let bytes = common::unxz(&common::test_data("drive9min").join("truth.nav.xz"));
     String::from_utf8(bytes)
         .expect("utf-8")
         .lines()

@@ -1,6 +1,6 @@
 //! Free-inertial navigation of the drive9min data set against its truth: a 530-s car
 //! drive made by gnss-ins-sim (not by schuler), with KF-GINS's published figures on the
-//! same data (`../shared/data/drive9min/README.md`).
+//! same data (`tests/data/README.md`).
 
 use nalgebra::Vector3;
 use schuler::analysis::errors::{EpochErrors, NavRecord, errors_at};
@@ -19,7 +19,7 @@ fn unpack(dir: &Path, name: &str) -> PathBuf {
     let dst = dir.join(name);
     std::fs::write(
         &dst,
-        common::unxz(&common::shared_data("drive9min").join(format!("{name}.xz"))),
+        common::unxz(&common::test_data("drive9min").join(format!("{name}.xz"))),
     )
     .expect("write");
     dst
@@ -188,7 +188,7 @@ fn gnss_aided_is_at_least_as_accurate_as_kf_gins() {
         .args(["nav", "--imu"])
         .arg(&imu)
         .arg("--gnss")
-        .arg(common::shared_data("drive9min").join("GNSS.txt"))
+        .arg(common::test_data("drive9min").join("GNSS.txt"))
         .args([
             "--init-pos",
             "45.0712345678,7.6812345678,245",
@@ -278,7 +278,7 @@ fn a_kf_gins_configuration_runs_as_kf_gins_does() {
          \x20 abstd: [20.0, 20.0, 20.0]\n  gsstd: [1000.0, 1000.0, 1000.0]\n\
          \x20 asstd: [1000.0, 1000.0, 1000.0]\n  corrtime: 0.5\nantlever: [ 0.0, 0.0, 0.0 ]\n",
         imu.display(),
-        common::shared_data("drive9min").join("GNSS.txt").display(),
+        common::test_data("drive9min").join("GNSS.txt").display(),
         out.display()
     );
     let cfg = dir.path().join("kf-gins.yaml");
@@ -351,7 +351,7 @@ fn the_outage_test_reports_each_outage() {
         .args(["nav", "--imu"])
         .arg(&imu)
         .arg("--gnss")
-        .arg(common::shared_data("drive9min").join("GNSS.txt"))
+        .arg(common::test_data("drive9min").join("GNSS.txt"))
         .args([
             "--init-pos",
             "45.0712345678,7.6812345678,245",
@@ -412,7 +412,7 @@ fn the_aided_wander_run_matches_the_ned_run() {
             .args(["nav", "--imu"])
             .arg(&imu)
             .arg("--gnss")
-            .arg(common::shared_data("drive9min").join("GNSS.txt"))
+            .arg(common::test_data("drive9min").join("GNSS.txt"))
             .args([
                 "--init-pos",
                 "45.0712345678,7.6812345678,245",
@@ -452,7 +452,7 @@ use predicates::prelude::PredicateBooleanExt as _;
 fn bad_aiding_options_name_the_flag_and_results_survive_a_late_error() {
     let dir = tempfile::tempdir().expect("tempdir");
     let imu = unpack(dir.path(), "IMU.txt");
-    let gnss = common::shared_data("drive9min").join("GNSS.txt");
+    let gnss = common::test_data("drive9min").join("GNSS.txt");
     let nav = |extra: &[&str]| {
         let mut c = assert_cmd::Command::cargo_bin("schuler").expect("binary");
         c.args(["nav", "--imu"])
@@ -491,7 +491,7 @@ fn bad_aiding_options_name_the_flag_and_results_survive_a_late_error() {
     // A log whose line 30001 is broken: the run stops there with the error, and the
     // 29 999 epochs before it are in nav.txt.
     let text = String::from_utf8(common::unxz(
-        &common::shared_data("drive9min").join("IMU.txt.xz"),
+        &common::test_data("drive9min").join("IMU.txt.xz"),
     ))
     .expect("utf-8");
     let broken: String = text

@@ -248,7 +248,7 @@ fn bad_scenarios_name_the_key() {
 /// body/NED mix-up, would show hundreds of metres and tens of degrees).
 #[test]
 fn gnss_ins_sim_motion_file_follows_its_truth() {
-    let data = common::shared_data("drive9min");
+    let data = common::test_data("drive9min");
     let dir = tempfile::tempdir().expect("tempdir");
     std::fs::copy(data.join("motion.csv"), dir.path().join("motion.csv")).expect("copy");
     let cfg = scenario(

@@ -1,18 +1,18 @@
-//! Helpers shared by the CLI's integration tests: the shared data sets and the
-//! KF-GINS text files the commands write.
+//! Helpers shared by the CLI's integration tests: the data sets kept in the repository
+//! (`tests/data/`, provenance in its README) and the KF-GINS text files the commands write.
 
 #![allow(dead_code)] // each test crate uses its own subset
 
 use std::path::{Path, PathBuf};
 
-/// A data set under `../shared/data/` (beside the checkout), which must exist.
-pub fn shared_data(name: &str) -> PathBuf {
+/// A data set under the repository's `tests/data/`, which must exist.
+pub fn test_data(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../tests/data")
         .join(name);
     assert!(
         dir.is_dir(),
-        "{} is missing: the shared data sets live beside the checkout",
+        "{} is missing: the test data sets are part of the repository",
         dir.display()
     );
     dir
