@@ -8,12 +8,14 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::filter::{Gate, GnssFix, ImuNoise, IntegrationConfig};
+use schuler::session::FilterConfig;
 use schuler::sim::analytic::{self, Maneuvering};
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
-use schuler_cli::commands::aided::{Aiding, navigate_aided};
-use schuler_cli::commands::nav::{EarthChoice, NavSettings};
+use schuler_cli::aided::{Aiding, OutputNames};
 use schuler_cli::formats::{ImuReadOptions, ImuReader};
-use schuler_cli::output::{NavWriter, write_imu_text};
+use schuler_cli::navigate::{NavSettings, navigate};
+use schuler_cli::options::EarthChoice;
+use schuler_cli::output::write_imu_text;
 use std::path::PathBuf;
 
 const T0: f64 = 86_400.0;
@@ -61,10 +63,11 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         out: dir.join("out"),
         earth: EarthChoice::Wgs84,
         week: 2200,
+        mechanization: Default::default(),
     };
     let aiding = Aiding {
         fixes,
-        config: IntegrationConfig {
+        filter: FilterConfig::new(IntegrationConfig {
             noise,
             scale_factors: true,
             lever_arm: Vector3::zeros(),
@@ -76,14 +79,13 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
             init_att_std: Vector3::repeat(0.01f64.to_radians()),
             init_sensor_std: None,
             baro: None,
-        },
-        smooth: false,
-        names: schuler_cli::commands::aided::OutputNames::SCHULER,
+        }),
+        names: OutputNames::SCHULER,
         initial_errors: Default::default(),
         outage_test: None,
-        baro: None,
+        baro: Vec::new(),
         // The navigation alone (the HTML report's cost is stated in the README).
-        report: schuler_cli::commands::aided_report::ReportSettings {
+        report: schuler_cli::aided::report::ReportSettings {
             html: false,
             ..Default::default()
         },
@@ -101,8 +103,8 @@ fn bench_aided(c: &mut Criterion) {
         group.bench_function(format!("21_states_1h_{rate}hz_gnss_1hz_out_1hz"), |b| {
             b.iter(|| {
                 let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
-                let writer = NavWriter::create(&settings.out, settings.week).expect("create");
-                navigate_aided(Wgs84, &settings, &aiding, &mut reader, writer, |_| {})
+                let start = settings.start();
+                navigate(Wgs84, &settings, Some(&aiding), start, &mut reader, |_| {})
                     .expect("navigate")
             })
         });

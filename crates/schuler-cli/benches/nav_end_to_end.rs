@@ -7,9 +7,10 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::sim::analytic::{self, Maneuvering};
-use schuler_cli::commands::nav::{EarthChoice, NavSettings, navigate};
 use schuler_cli::formats::{ImuReadOptions, ImuReader};
-use schuler_cli::output::{NavWriter, write_imu_text};
+use schuler_cli::navigate::{NavSettings, navigate};
+use schuler_cli::options::EarthChoice;
+use schuler_cli::output::write_imu_text;
 use std::path::PathBuf;
 
 const RATE_HZ: f64 = 200.0;
@@ -36,6 +37,7 @@ fn bench_nav(c: &mut Criterion) {
         out: dir.join("out"),
         earth: EarthChoice::Wgs84,
         week: 2200,
+        mechanization: Default::default(),
     };
     let mut group = c.benchmark_group("nav_end_to_end");
     group.sample_size(10);
@@ -43,8 +45,15 @@ fn bench_nav(c: &mut Criterion) {
     group.bench_function("kf_gins_text_1h_200hz_out_10hz", |b| {
         b.iter(|| {
             let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
-            let writer = NavWriter::create(&settings.out, settings.week).expect("create");
-            navigate(Wgs84, &settings, &mut reader, writer, |_| {}).expect("navigate")
+            navigate(
+                Wgs84,
+                &settings,
+                None,
+                settings.start(),
+                &mut reader,
+                |_| {},
+            )
+            .expect("navigate")
         })
     });
     group.finish();

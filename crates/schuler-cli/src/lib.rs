@@ -1,9 +1,14 @@
 //! The `schuler` command-line tool as a library: file formats, writers and the
 //! commands, so that tests and benchmarks drive exactly what the binary runs.
 
+pub mod aided;
+pub mod alignment;
 pub mod commands;
+pub mod drive;
 pub mod fixed;
 pub mod formats;
+pub mod navigate;
+pub mod options;
 pub mod output;
 pub mod plot;
 pub mod report;

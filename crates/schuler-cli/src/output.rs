@@ -16,6 +16,7 @@
 
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
+use schuler::analysis::errors::EpochErrors;
 use schuler::earth::{EarthModel, Geodetic};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
@@ -455,6 +456,42 @@ pub fn write_imu_text(
     }
     w.flush()
         .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Header of `errors.csv`.
+pub const ERRORS_CSV_HEADER: &str = "t_sow,north_m,east_m,down_m,horizontal_m,vn_mps,ve_mps,\
+vd_mps,roll_deg,pitch_deg,yaw_deg,interpolated";
+
+/// Writes `errors.csv`: one row per matched epoch, shortest round-trip numbers.
+pub fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
+    let file =
+        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut w = std::io::BufWriter::new(file);
+    let mut line = String::with_capacity(256);
+    use std::fmt::Write as _;
+    writeln!(w, "{ERRORS_CSV_HEADER}")?;
+    for e in errors {
+        line.clear();
+        let _ = write!(line, "{}", e.t_sow);
+        for x in [
+            e.pos_n.x,
+            e.pos_n.y,
+            e.pos_n.z,
+            e.horizontal(),
+            e.v_n.x,
+            e.v_n.y,
+            e.v_n.z,
+            e.att.roll.to_degrees(),
+            e.att.pitch.to_degrees(),
+            e.att.yaw.to_degrees(),
+        ] {
+            let _ = write!(line, ",{x}");
+        }
+        let _ = writeln!(line, ",{}", u8::from(e.interpolated));
+        w.write_all(line.as_bytes())?;
+    }
+    w.flush()
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 #[cfg(test)]

@@ -6,9 +6,10 @@ use nalgebra::Vector3;
 use schuler::analysis::errors::{EpochErrors, NavRecord, errors_at};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::rotation::Euler;
-use schuler_cli::commands::nav::{EarthChoice, NavSettings, navigate};
+use schuler::session::{MechanizationChoice, MechanizationConfig};
 use schuler_cli::formats::{ImuReadOptions, ImuReader};
-use schuler_cli::output::NavWriter;
+use schuler_cli::navigate::{NavSettings, navigate};
+use schuler_cli::options::EarthChoice;
 mod common;
 
 use std::collections::HashMap;
@@ -100,10 +101,21 @@ fn run(dir: &Path, imu: PathBuf) -> Errors {
         out: dir.join("out"),
         earth: EarthChoice::Wgs84,
         week: 0,
+        mechanization: MechanizationConfig {
+            choice: MechanizationChoice::Ned,
+            ..MechanizationConfig::default()
+        },
     };
     let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
-    let writer = NavWriter::create(&settings.out, 0).expect("writer");
-    navigate(Wgs84, &settings, &mut reader, writer, |_| {}).expect("navigate");
+    navigate(
+        Wgs84,
+        &settings,
+        None,
+        settings.start(),
+        &mut reader,
+        |_| {},
+    )
+    .expect("navigate");
     errors(&dir.join("out/nav.txt"), &unpack(dir, "truth.nav"))
 }
 

@@ -7,14 +7,13 @@ use assert_cmd::Command;
 use predicates::prelude::*;
 use schuler::earth::{EarthModel, Wgs84, c_ne};
 use schuler::nav::NavState;
+use schuler::session::{MechanizationChoice, MechanizationConfig, MechanizationKind, Summary};
 use schuler::sim::analytic::{self, Trajectory};
 use schuler::sim::jet::{Jet, JetMat3, JetVec3};
-use schuler_cli::commands::nav::{
-    EarthChoice, MechanizationChoice, MechanizationKind, MechanizationSettings, NavSettings,
-    NavSummary, navigate_with,
-};
 use schuler_cli::formats::{ImuReadOptions, ImuReader};
-use schuler_cli::output::{CSV_HEADER_EXTENDED, NavWriter, write_imu_text};
+use schuler_cli::navigate::{NavSettings, navigate};
+use schuler_cli::options::EarthChoice;
+use schuler_cli::output::{CSV_HEADER_EXTENDED, write_imu_text};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -106,7 +105,7 @@ fn initial_state() -> NavState {
 }
 
 /// Navigates the log with `mechanization` into `out`, at 10 Hz.
-fn run(mechanization: MechanizationSettings, out: &Path) -> NavSummary {
+fn run(mechanization: MechanizationConfig, out: &Path) -> Summary {
     let init = initial_state();
     let settings = NavSettings {
         imu: imu_log().to_path_buf(),
@@ -118,18 +117,19 @@ fn run(mechanization: MechanizationSettings, out: &Path) -> NavSummary {
         out: out.to_path_buf(),
         earth: EarthChoice::Wgs84,
         week: 0,
+        mechanization,
     };
     let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
-    let writer = NavWriter::create_extended(out, 0, &Wgs84).expect("writer");
-    navigate_with(
+    navigate(
         Wgs84,
         &settings,
-        &mechanization,
+        None,
+        settings.start(),
         &mut reader,
-        writer,
         |_| {},
     )
     .expect("navigate")
+    .nav
 }
 
 fn numbers(line: &str, sep: char) -> Vec<f64> {
@@ -171,10 +171,10 @@ fn check_formats(out: &Path) {
     }
 }
 
-fn settings(choice: MechanizationChoice) -> MechanizationSettings {
-    MechanizationSettings {
+fn settings(choice: MechanizationChoice) -> MechanizationConfig {
+    MechanizationConfig {
         choice,
-        ..MechanizationSettings::default()
+        ..MechanizationConfig::default()
     }
 }
 
@@ -210,7 +210,7 @@ fn wander_over_the_pole_through_the_cli() {
 #[test]
 fn auto_hands_over_both_ways() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let mech = MechanizationSettings {
+    let mech = MechanizationConfig {
         choice: MechanizationChoice::Auto,
         auto_latitude: 89f64.to_radians(),
         hysteresis: 0.5f64.to_radians(),

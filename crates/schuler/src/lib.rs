@@ -13,5 +13,6 @@ pub mod filter;
 pub mod imu;
 pub mod nav;
 pub mod rotation;
+pub mod session;
 pub mod sim;
 pub mod units;

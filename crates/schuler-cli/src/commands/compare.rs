@@ -7,13 +7,13 @@
 //! [`schuler::analysis::statistics`]), shared with the aided run's report.
 
 use crate::formats::nav::{NavFormat, read_nav};
+use crate::output::write_errors_csv;
 use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result};
 use schuler::analysis::errors::EpochErrors;
 use schuler::analysis::statistics::{Comparison, OutageMax, QUANTITIES, Quantity, compare};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `schuler compare`.
@@ -206,41 +206,6 @@ pub fn summary_json(c: &Comparison, nav: (&Path, NavFormat), truth: (&Path, NavF
             "yaw_deg": r.att.yaw.to_degrees(),
         })),
     })
-}
-
-/// Header of `errors.csv`.
-pub const ERRORS_CSV_HEADER: &str = "t_sow,north_m,east_m,down_m,horizontal_m,vn_mps,ve_mps,\
-vd_mps,roll_deg,pitch_deg,yaw_deg,interpolated";
-
-/// Writes `errors.csv`: one row per matched epoch, shortest round-trip numbers.
-pub(crate) fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
-    let mut line = String::with_capacity(256);
-    writeln!(w, "{ERRORS_CSV_HEADER}")?;
-    for e in errors {
-        line.clear();
-        let _ = write!(line, "{}", e.t_sow);
-        for x in [
-            e.pos_n.x,
-            e.pos_n.y,
-            e.pos_n.z,
-            e.horizontal(),
-            e.v_n.x,
-            e.v_n.y,
-            e.v_n.z,
-            e.att.roll.to_degrees(),
-            e.att.pitch.to_degrees(),
-            e.att.yaw.to_degrees(),
-        ] {
-            let _ = write!(line, ",{x}");
-        }
-        let _ = writeln!(line, ",{}", u8::from(e.interpolated));
-        w.write_all(line.as_bytes())?;
-    }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// Writes the three plots: position, velocity and attitude errors against time, the

@@ -8,15 +8,18 @@
 //! factors, as KF-GINS's. Relative paths are taken from the working directory, as
 //! KF-GINS does.
 
-use super::aided::{Aiding, OutputNames};
-use super::nav::{EarthChoice, NavSettings};
+use crate::aided::report::ReportSettings;
+use crate::aided::{Aiding, OutputNames};
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions};
+use crate::navigate::{NavSettings, navigate};
+use crate::options::EarthChoice;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
 use schuler::filter::integration::SensorEstimates;
 use schuler::filter::{Gate, IntegrationConfig};
 use schuler::rotation::Euler;
+use schuler::session::{FilterConfig, MechanizationChoice, MechanizationConfig, Start};
 use schuler::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MGAL, PPM};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -87,8 +90,8 @@ fn non_negative(key: &str, v: &[f64]) -> Result<Vector3<f64>> {
     Ok(Vector3::from_column_slice(v))
 }
 
-/// Read and check a KF-GINS configuration.
-pub fn load(path: &Path) -> Result<KfGinsRun> {
+/// Read a KF-GINS configuration and check its header values.
+fn read_yaml(path: &Path) -> Result<KfGinsYaml> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     let y: KfGinsYaml =
@@ -122,14 +125,17 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
             n.corrtime
         );
     }
-    let key = |k: &str| format!("{}: {k}", path.display());
+    Ok(y)
+}
+
+/// The IMU noise model of `imunoise`, in SI units (Gauss–Markov biases and scale
+/// factors with the correlation time `corrtime`, as KF-GINS models them).
+fn noise(n: &ImuNoiseYaml, key: &dyn Fn(&str) -> String) -> Result<schuler::filter::ImuNoise> {
     let tau = n.corrtime * 3600.0;
     let gb = non_negative(&key("imunoise.gbstd"), &n.gbstd)? * DEG_PER_H;
     let ab = non_negative(&key("imunoise.abstd"), &n.abstd)? * MGAL;
-    let gs = non_negative(&key("imunoise.gsstd"), &n.gsstd)? * PPM;
-    let as_ = non_negative(&key("imunoise.asstd"), &n.asstd)? * PPM;
     let walk = |s: Vector3<f64>| s * (2.0 / tau).sqrt();
-    let noise = schuler::filter::ImuNoise {
+    Ok(schuler::filter::ImuNoise {
         arw: non_negative(&key("imunoise.arw"), &n.arw)? * DEG_PER_SQRT_H,
         vrw: non_negative(&key("imunoise.vrw"), &n.vrw)? * M_PER_S_PER_SQRT_H,
         gyro_bias: gb,
@@ -138,20 +144,45 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         accel_bias_walk: walk(ab),
         gyro_bias_tau: tau,
         accel_bias_tau: tau,
-        gyro_scale: gs,
-        accel_scale: as_,
+        gyro_scale: non_negative(&key("imunoise.gsstd"), &n.gsstd)? * PPM,
+        accel_scale: non_negative(&key("imunoise.asstd"), &n.asstd)? * PPM,
         scale_tau: tau,
-    };
+    })
+}
+
+/// The filter of a configuration: KF-GINS's 21 states with its prior.
+fn integration(y: &KfGinsYaml, key: &dyn Fn(&str) -> String) -> Result<IntegrationConfig> {
+    let noise = noise(&y.imunoise, key)?;
     let init_std =
         |k: &str, v: Option<[f64; 3]>, default: Vector3<f64>, unit: f64| -> Result<Vector3<f64>> {
             v.map_or(Ok(default), |v| positive(&key(k), &v).map(|x| x * unit))
         };
     let sensor_std = [
-        init_std("initbgstd", y.initbgstd, gb, DEG_PER_H)?,
-        init_std("initbastd", y.initbastd, ab, MGAL)?,
-        init_std("initsgstd", y.initsgstd, gs, PPM)?,
-        init_std("initsastd", y.initsastd, as_, PPM)?,
+        init_std("initbgstd", y.initbgstd, noise.gyro_bias, DEG_PER_H)?,
+        init_std("initbastd", y.initbastd, noise.accel_bias, MGAL)?,
+        init_std("initsgstd", y.initsgstd, noise.gyro_scale, PPM)?,
+        init_std("initsastd", y.initsastd, noise.accel_scale, PPM)?,
     ];
+    Ok(IntegrationConfig {
+        noise,
+        scale_factors: true,
+        lever_arm: Vector3::from(y.antlever),
+        // KF-GINS has no innovation test; keep ours on at its default level.
+        gate: Gate::Level(1e-4),
+        reset_after: 5,
+        propagation_interval: 1.0,
+        init_pos_std: positive(&key("initposstd"), &y.initposstd)?,
+        init_vel_std: positive(&key("initvelstd"), &y.initvelstd)?,
+        init_att_std: positive(&key("initattstd"), &y.initattstd)?.map(f64::to_radians),
+        init_sensor_std: Some(sensor_std),
+        baro: None,
+    })
+}
+
+/// Read and check a KF-GINS configuration.
+pub fn load(path: &Path) -> Result<KfGinsRun> {
+    let y = read_yaml(path)?;
+    let key = |k: &str| format!("{}: {k}", path.display());
     let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)?;
     fixes.retain(|f| f.t >= y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));
     let settings = NavSettings {
@@ -171,28 +202,19 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
         out: y.outputpath.clone(),
         earth: EarthChoice::Wgs84,
         week: 0,
+        // KF-GINS navigates in NED.
+        mechanization: MechanizationConfig {
+            choice: MechanizationChoice::Ned,
+            ..MechanizationConfig::default()
+        },
     };
     let aiding = Aiding {
         fixes,
-        config: IntegrationConfig {
-            noise,
-            scale_factors: true,
-            lever_arm: Vector3::from(y.antlever),
-            // KF-GINS has no innovation test; keep ours on at its default level.
-            gate: Gate::Level(1e-4),
-            reset_after: 5,
-            propagation_interval: 1.0,
-            init_pos_std: positive(&key("initposstd"), &y.initposstd)?,
-            init_vel_std: positive(&key("initvelstd"), &y.initvelstd)?,
-            init_att_std: positive(&key("initattstd"), &y.initattstd)?.map(f64::to_radians),
-            init_sensor_std: Some(sensor_std),
-            baro: None,
-        },
-        smooth: false,
+        filter: FilterConfig::new(integration(&y, &key)?),
         names: OutputNames::KF_GINS,
         outage_test: None,
-        baro: None,
-        report: super::aided_report::ReportSettings::default(),
+        baro: Vec::new(),
+        report: ReportSettings::default(),
         vehicle: Default::default(),
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
@@ -210,21 +232,19 @@ pub fn run(path: &Path) -> Result<()> {
     let started = Instant::now();
     let KfGinsRun { settings, aiding } = load(path)?;
     let mut reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
-    let writer = crate::output::NavWriter::create_named(
-        &settings.out,
-        aiding.names.nav,
-        settings.week,
-        &schuler::earth::Wgs84,
-    )?;
-    let summary = super::aided::navigate_aided(
+    let start = Start {
+        estimates: aiding.initial_errors,
+        ..settings.start()
+    };
+    let summary = navigate(
         schuler::earth::Wgs84,
         &settings,
-        &aiding,
+        Some(&aiding),
+        start,
         &mut reader,
-        writer,
         |_| {},
     )?;
-    let c = summary.counts;
+    let c = summary.nav.counts;
     println!(
         "KF-GINS configuration {}: {} samples, {} GNSS fixes ({} position updates, {} rejected, {} outside the IMU data) in {:.2} s; wrote {} epochs to {}",
         path.display(),
@@ -234,7 +254,7 @@ pub fn run(path: &Path) -> Result<()> {
         c.rejected,
         c.skipped,
         started.elapsed().as_secs_f64(),
-        summary.nav.epochs,
+        summary.epochs,
         settings.out.join(aiding.names.nav).display()
     );
     print!("{}", summary.report_text);

@@ -1,9 +1,6 @@
 //! One module per `schuler` subcommand: each parses its arguments and wires library
 //! calls to readers and writers.
 
-pub mod aided;
-pub mod aided_record;
-pub mod aided_report;
 pub mod align;
 pub mod channel;
 pub mod compare;
@@ -12,5 +9,4 @@ pub mod kf_gins;
 pub mod nav;
 pub mod platform;
 pub mod simulate;
-pub mod vehicle;
 pub mod vertical;

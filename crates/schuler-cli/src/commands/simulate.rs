@@ -28,7 +28,7 @@
 //! ([`schuler::sim::run::simulate_with`]). The same scenario and seed give the same
 //! bytes.
 
-use super::aided::{imu_err_row, push_table_row};
+use crate::drive::{imu_err_row, push_table_row};
 use crate::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
 use crate::output::{push_nav_fields, put_imu_increments, put_nav_fields};
 use anyhow::{Context, Result};

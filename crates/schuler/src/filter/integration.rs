@@ -27,7 +27,7 @@ use super::vehicle::{self, Baseline, HeadingReading, VehicleMount};
 use crate::earth::{EarthModel, Geodetic};
 use crate::imu::ImuSample;
 use crate::nav::{ErrorFrame, NavErrors, NavState};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, Vector3};
 
 /// One GNSS epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -318,6 +318,29 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
     }
 
+    /// Replace the prior of the attitude error (about north, east, down) and the gyro
+    /// and accelerometer biases by the joint covariance `p` (order: attitude, gyro
+    /// bias, accelerometer bias), e.g. an alignment's, whose tilts and horizontal
+    /// accelerometer biases are correlated at rest. The attitude rows are turned into
+    /// the computation frame (`C_cn P C_nc`). Call before [`Integrator::with_smoother`].
+    pub fn with_attitude_bias_covariance(mut self, p: &SMatrix<f64, 9, 9>) -> Self {
+        let frame = self.mech.frame();
+        let c = measurement::c_nc(&frame, &self.mech.state().pos);
+        let mut t = SMatrix::<f64, 9, 9>::identity();
+        t.fixed_view_mut::<3, 3>(0, 0).copy_from(&c);
+        let rotated = t * p * t.transpose();
+        let at = [Layout::ATT, Layout::GYRO_BIAS, Layout::ACCEL_BIAS];
+        for (i, oi) in at.iter().enumerate() {
+            for (j, oj) in at.iter().enumerate() {
+                self.kf
+                    .p
+                    .fixed_view_mut::<3, 3>(*oi, *oj)
+                    .copy_from(&rotated.fixed_view::<3, 3>(3 * i, 3 * j));
+            }
+        }
+        self
+    }
+
     /// Start from sensor-error estimates other than zero (e.g. a previous run's).
     pub fn with_estimates(mut self, estimates: SensorEstimates) -> Self {
         self.estimates = estimates;
@@ -450,22 +473,18 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 
     /// Mechanize a sample during which GNSS fixes may fall: fixes from `fixes` with
     /// times up to the sample's end are applied at their own times.
-    pub fn step_with_fixes<I: Iterator<Item = GnssFix>>(
-        &mut self,
-        raw: &ImuSample,
-        fixes: &mut std::iter::Peekable<I>,
-    ) {
+    pub fn step_with_fixes<F: FixSource>(&mut self, raw: &ImuSample, fixes: &mut F) {
         let tol = 1e-3 * raw.dt.max(1e-9);
         let mut rest = Some(*raw);
-        while let Some(&f) = fixes.peek() {
+        while let Some(f) = fixes.peek_fix() {
             let now = self.mech.state().t;
             if f.t < now - tol {
-                fixes.next();
+                fixes.pop_fix();
                 self.skip(f.t, SkipReason::BeforeImu);
                 continue;
             }
             if f.t <= now + tol {
-                fixes.next();
+                fixes.pop_fix();
                 self.update_gnss(&f);
                 continue;
             }
@@ -473,7 +492,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             if f.t > r.t + tol {
                 break;
             }
-            fixes.next();
+            fixes.pop_fix();
             if f.t < r.t - tol {
                 let (a, b) = split(&r, f.t);
                 self.step(&a);
@@ -486,6 +505,49 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
         if let Some(r) = rest {
             self.step(&r);
+        }
+    }
+
+    /// Continue on another mechanization of the same instant (the NED <-> wander
+    /// hand-over): `to` makes it from the current one, and the navigation error
+    /// blocks of the covariance are turned from the old computation frame `c` to the
+    /// new `c'`, `P' = T P Tᵀ` with `T = diag(C, C, C, I)`, `C = C_c'e C_ec` (position,
+    /// velocity and attitude errors are all resolved in `c`, [`crate::nav::frame`];
+    /// the sensor errors are in body axes and stay). The smoother records the turn as
+    /// a transition `Φ = T` without process noise, so it smooths across it.
+    pub fn hand_over<M2: ErrorFrame>(mut self, to: impl FnOnce(&M) -> M2) -> Integrator<M2, E> {
+        self.propagate();
+        let before = self.mech.frame();
+        let mech = to(&self.mech);
+        let after = mech.frame();
+        let c = after.c_ce_to_e.transpose() * before.c_ce_to_e;
+        let n = self.model.layout.n;
+        let mut t = DMatrix::identity(n, n);
+        for o in [Layout::POS, Layout::VEL, Layout::ATT] {
+            t.fixed_view_mut::<3, 3>(o, o).copy_from(&c);
+        }
+        let p_post = self.kf.p.clone();
+        let p = &t * &p_post * t.transpose();
+        self.kf.p = (&p + p.transpose()) * 0.5;
+        if let Some(log) = self.smoother.as_mut() {
+            log.propagated(before.t, &p_post, t, &self.kf.p);
+        }
+        Integrator {
+            mech,
+            earth: self.earth,
+            model: self.model,
+            kf: self.kf,
+            cfg: self.cfg,
+            interval: Interval::default(),
+            estimates: self.estimates,
+            w_ib_b: self.w_ib_b,
+            rejected: self.rejected,
+            skipped: self.skipped,
+            innovations: self.innovations,
+            counts: self.counts,
+            gate_resets: self.gate_resets,
+            consecutive_rejections: self.consecutive_rejections,
+            smoother: self.smoother,
         }
     }
 
@@ -687,6 +749,33 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         };
         self.propagate();
         self.apply(reading.t, m)
+    }
+}
+
+/// GNSS fixes in time order, taken one at a time by [`Integrator::step_with_fixes`]:
+/// a peekable iterator (a batch) or a queue that a streaming caller keeps filling.
+pub trait FixSource {
+    /// The next fix, left in place.
+    fn peek_fix(&mut self) -> Option<GnssFix>;
+    /// Drop the next fix (after it was used or skipped).
+    fn pop_fix(&mut self);
+}
+
+impl<I: Iterator<Item = GnssFix>> FixSource for std::iter::Peekable<I> {
+    fn peek_fix(&mut self) -> Option<GnssFix> {
+        self.peek().copied()
+    }
+    fn pop_fix(&mut self) {
+        self.next();
+    }
+}
+
+impl FixSource for std::collections::VecDeque<GnssFix> {
+    fn peek_fix(&mut self) -> Option<GnssFix> {
+        self.front().copied()
+    }
+    fn pop_fix(&mut self) {
+        self.pop_front();
     }
 }
 

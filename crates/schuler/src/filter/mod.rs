@@ -25,7 +25,7 @@ pub mod smoother;
 pub mod vehicle;
 
 pub use error_model::{ErrorModel, IntervalMeans};
-pub use integration::{GnssFix, IntegrationConfig, Integrator, SensorEstimates};
+pub use integration::{FixSource, GnssFix, IntegrationConfig, Integrator, SensorEstimates};
 pub use kalman::{Gate, Kalman, Rejection, Update};
 pub use layout::Layout;
 pub use noise::ImuNoise;

@@ -28,7 +28,7 @@ use nalgebra::Vector3;
 use schuler::align::{AlignConfig, Alignment, align};
 use schuler::earth::Wgs84;
 use schuler::filter::ImuNoise;
-use schuler::nav::LocalLevel;
+use schuler::session::MechanizationChoice;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -36,7 +36,8 @@ pub use crossing::Crossing;
 pub use sortie::{POLAR_FLIGHT, Sortie};
 
 /// The sortie's mechanization: NED (70 N is far from the poles).
-type Ned = LocalLevel<Wgs84>;
+/// The sortie navigates in NED (70° N).
+const NED: MechanizationChoice = MechanizationChoice::Ned;
 
 /// Arguments of `schuler demo`.
 #[derive(clap::Args, Debug)]
@@ -172,17 +173,21 @@ pub fn run(args: DemoArgs) -> Result<()> {
     ];
     let ((forward, smoothed), inertial, coarse_only, no_baro) = std::thread::scope(|scope| {
         let aided = scope.spawn(|| {
-            modes::aided::<Ned>(
+            modes::aided(
                 &rec,
                 &fine_start,
-                &modes::Prior::from_alignment(&alignments.fine),
+                &modes::Prior::from_alignment(
+                    &alignments.fine,
+                    Vector3::repeat(modes::PAD_SURVEY_STD),
+                ),
                 &aided_settings,
+                MechanizationChoice::Ned,
                 &bars[0],
             )
         });
-        let inertial = modes::inertial::<Ned>(&rec, &fine_start, Some(gains), &bars[1]);
-        let coarse_only = modes::inertial::<Ned>(&rec, &coarse_start, Some(gains), &bars[2]);
-        let no_baro = modes::inertial::<Ned>(&rec, &fine_start, None, &bars[3]);
+        let inertial = modes::inertial(&rec, &fine_start, Some(gains), NED, &bars[1]);
+        let coarse_only = modes::inertial(&rec, &coarse_start, Some(gains), NED, &bars[2]);
+        let no_baro = modes::inertial(&rec, &fine_start, None, NED, &bars[3]);
         let aided = aided
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));

@@ -1,22 +1,22 @@
-//! A recording navigated the seed's ways, each from a given start on a given
-//! mechanization (NED, or the all-latitude wander frame through
-//! [`AidedMechanization`]): the inertial mode (free strapdown, its vertical channel
+//! A recording navigated the seed's ways through the library's session, each from a
+//! given start on a given mechanization (NED, or the all-latitude wander frame): the
+//! inertial mode (free strapdown, its vertical channel
 //! with or without the baro loop) and the inertial-satellite mode (error-state Kalman
 //! filter on GNSS position and velocity and the barometer; forward, and smoothed).
 
 use super::capture::Recording;
-use crate::commands::aided::AidedMechanization;
-use crate::commands::nav::MechanizationKind;
 use indicatif::ProgressBar;
 use nalgebra::Vector3;
-use schuler::align::Alignment;
 use schuler::channel::detector::DetectorConfig;
 use schuler::channel::vertical::{DetectorCounts, Gains};
 use schuler::earth::{EarthModel, Wgs84};
-use schuler::filter::integration::{IntegrationConfig, Integrator, SensorEstimates};
-use schuler::filter::kalman::std3;
-use schuler::filter::{Gate, ImuNoise, Layout};
-use schuler::nav::{BaroLoop, NavState};
+use schuler::filter::integration::{IntegrationConfig, SensorEstimates};
+use schuler::filter::{GnssFix, ImuNoise};
+use schuler::nav::NavState;
+use schuler::session::{
+    Aid, BaroLoopConfig, Event, FilterConfig, Finished, MechanizationChoice, MechanizationConfig,
+    MechanizationKind, Session, SessionConfig,
+};
 use std::time::Instant;
 
 /// One output epoch (once a second).
@@ -30,18 +30,6 @@ pub struct Epoch {
     /// Wander azimuth [rad] (the navigation frame's x axis east of north), when the
     /// wander mechanization runs.
     pub wander_azimuth: Option<f64>,
-}
-
-impl Epoch {
-    /// The epoch a mechanization reports now, with the filter's `std` if any.
-    fn of<M: AidedMechanization<Wgs84>>(mech: &M, std: Option<[Vector3<f64>; 3]>) -> Self {
-        let e = mech.epoch(&Wgs84);
-        Self {
-            state: e.state,
-            std,
-            wander_azimuth: (M::KIND == MechanizationKind::Wander).then_some(e.wander_azimuth),
-        }
-    }
 }
 
 /// The filter's sensor-error estimates at one epoch with their standard deviations.
@@ -72,28 +60,11 @@ pub struct Track {
     pub seconds: f64,
 }
 
-/// Where navigation starts: the aligned state and the sensor errors alignment found.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Start {
-    /// The aligned state.
-    pub state: NavState,
-    /// Sensor errors removed from every sample.
-    pub estimates: SensorEstimates,
-}
+pub use schuler::session::{Prior, Start};
 
-impl Start {
-    /// The start an alignment gives.
-    pub fn from_alignment(a: &Alignment) -> Self {
-        Self {
-            state: a.state,
-            estimates: SensorEstimates {
-                gyro_bias: a.gyro_bias,
-                accel_bias: a.accel_bias,
-                ..SensorEstimates::default()
-            },
-        }
-    }
-}
+/// Standard deviation of the pad's surveyed position [m] (the filter's position
+/// prior after the alignment on the pad).
+pub const PAD_SURVEY_STD: f64 = 0.5;
 
 /// Time constant of the baro loop [s] (the seed: tens of seconds).
 pub const BARO_LOOP_TAU: f64 = 30.0;
@@ -106,52 +77,99 @@ pub fn baro_gains(start: &NavState) -> anyhow::Result<Gains> {
     Ok(Gains::critical(BARO_LOOP_TAU, w0_sq)?)
 }
 
-/// Readings `baro[*next..]` that fall at or before the end of `sample` (to half a
-/// sample): their heights, advancing `next`.
-fn due<'a>(baro: &'a [(f64, f64)], next: &mut usize, t: f64, dt: f64) -> &'a [(f64, f64)] {
-    let from = *next;
-    while *next < baro.len() && baro[*next].0 <= t + 0.5 * dt {
-        *next += 1;
-    }
-    &baro[from..*next]
-}
-
 /// The first reading after `t`.
 fn first_after(baro: &[(f64, f64)], t: f64) -> usize {
     baro.partition_point(|(tb, _)| *tb <= t + 1e-9)
 }
 
-/// The inertial mode on the mechanization `M`: free strapdown from `start`, the
-/// vertical channel damped by the baro loop when `gains` are given.
-pub fn inertial<M: AidedMechanization<Wgs84>>(
+/// Run `config` from `start` over the recording's samples from the start on, with the
+/// barometer readings after the start and `fixes`; the epochs once a second.
+fn run_session(
     rec: &Recording,
     start: &Start,
-    gains: Option<Gains>,
+    config: SessionConfig,
+    fixes: &[GnssFix],
     bar: &ProgressBar,
-) -> Track {
+) -> (Track, Finished) {
     let clock = Instant::now();
     let i0 = rec.sample_at(start.state.t);
     let per_second = rec.per_second();
-    let mut mech = M::start(Wgs84, start.state);
-    mech.prime(&start.estimates.compensate(&rec.imu[i0]));
-    let mut baro_loop = gains.map(|g| BaroLoop::new(g, DetectorConfig::default()));
-    let mut next_baro = first_after(&rec.baro, start.state.t);
     let mut track = Track::default();
-    track.epochs.push(Epoch::of(&mech, None));
-    for (k, raw) in rec.imu[i0 + 1..].iter().enumerate() {
-        mech.step(&start.estimates.compensate(raw));
-        if let Some(l) = baro_loop.as_mut() {
-            for &(_, h) in due(&rec.baro, &mut next_baro, raw.t, raw.dt) {
-                l.update(&mut mech, Some(h));
-            }
-        }
-        if (k + 1) % per_second == 0 {
-            track.epochs.push(Epoch::of(&mech, None));
+    let mut session = match Session::new(Wgs84, config, *start) {
+        Ok(s) => s,
+        Err(e) => unreachable!("the demo's session configuration is valid: {e}"),
+    };
+    let baro = &rec.baro[first_after(&rec.baro, start.state.t)..];
+    let aids = fixes
+        .iter()
+        .map(|f| Aid::Gnss(*f))
+        .chain(baro.iter().map(|&(t, h)| Aid::Baro { t, h }));
+    for aid in aids {
+        // The simulator's aids are finite: nothing to refuse.
+        let _ = session.push(aid);
+    }
+    for (k, raw) in rec.imu[i0..].iter().enumerate() {
+        // The simulator's samples are finite and in time order.
+        let _ = session.push_imu(*raw);
+        track.epochs.extend(session.epochs().map(|e| epoch(&e)));
+        track
+            .rejected
+            .extend(session.events().filter_map(|e| match e {
+                Event::Refused(r) => Some(r.t),
+                _ => None,
+            }));
+        if k % per_second == 0 && k > 0 {
             bar.inc(1);
         }
     }
-    track.baro = baro_loop.map(|l| l.counts);
+    let finished = match session.finish() {
+        Ok(f) => f,
+        Err(e) => unreachable!("the recording has samples: {e}"),
+    };
+    track.epochs.extend(finished.epochs.iter().map(epoch));
     track.seconds = clock.elapsed().as_secs_f64();
+    (track, finished)
+}
+
+/// A session's epoch as the demo keeps it.
+fn epoch(e: &schuler::session::Epoch) -> Epoch {
+    Epoch {
+        state: e.state,
+        std: e.filter.map(|f| f.nav_std),
+        wander_azimuth: (e.mechanization == MechanizationKind::Wander).then_some(e.wander_azimuth),
+    }
+}
+
+/// The session configuration for `choice`, epochs once a second.
+fn config(choice: MechanizationChoice) -> SessionConfig {
+    SessionConfig {
+        mechanization: MechanizationConfig {
+            choice,
+            ..MechanizationConfig::default()
+        },
+        output_rate: Some(1.0),
+        ..SessionConfig::default()
+    }
+}
+
+/// The inertial mode on the mechanization `choice`: free strapdown from `start`, the
+/// vertical channel damped by the baro loop when `gains` are given.
+pub fn inertial(
+    rec: &Recording,
+    start: &Start,
+    gains: Option<Gains>,
+    choice: MechanizationChoice,
+    bar: &ProgressBar,
+) -> Track {
+    let cfg = SessionConfig {
+        baro_loop: gains.map(|gains| BaroLoopConfig {
+            gains,
+            detector: DetectorConfig::default(),
+        }),
+        ..config(choice)
+    };
+    let (mut track, finished) = run_session(rec, start, cfg, &[], bar);
+    track.baro = finished.summary.baro_loop;
     track
 }
 
@@ -166,98 +184,45 @@ pub struct AidedSettings {
     pub baro_bias: (f64, f64),
 }
 
-/// The filter's initial uncertainty about the start.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Prior {
-    /// Position standard deviations (NED) [m].
-    pub pos_std: Vector3<f64>,
-    /// Velocity standard deviations (NED) [m/s].
-    pub vel_std: Vector3<f64>,
-    /// Attitude standard deviations (about north, east, down) [rad].
-    pub att_std: Vector3<f64>,
-    /// Gyro and accelerometer bias standard deviations [rad/s, m/s^2], when they
-    /// differ from the IMU model's.
-    pub bias_std: Option<[Vector3<f64>; 2]>,
-}
-
-impl Prior {
-    /// After an alignment on the pad: the position held to the pad's survey (0.5 m),
-    /// the velocity at zero (0.01 m/s), attitude and biases as alignment found them.
-    pub fn from_alignment(a: &Alignment) -> Self {
-        Self {
-            pos_std: Vector3::repeat(0.5),
-            vel_std: Vector3::repeat(0.01),
-            att_std: a.attitude_std,
-            bias_std: Some([a.gyro_bias_std, a.accel_bias_std]),
-        }
-    }
-}
-
-/// The inertial-satellite mode on the mechanization `M`: the 15-state error-state
-/// filter (plus the barometer bias) from `start` with the uncertainties `prior`;
-/// returns the forward track and the Rauch–Tung–Striebel smoothed one.
-pub fn aided<M: AidedMechanization<Wgs84>>(
+/// The inertial-satellite mode on the mechanization `choice`: the 15-state
+/// error-state filter (plus the barometer bias) from `start` with the uncertainties
+/// `prior`; returns the forward track and the Rauch–Tung–Striebel smoothed one.
+pub fn aided(
     rec: &Recording,
     start: &Start,
     prior: &Prior,
     settings: &AidedSettings,
+    choice: MechanizationChoice,
     bar: &ProgressBar,
 ) -> (Track, Track) {
-    let clock = Instant::now();
-    let cfg = IntegrationConfig {
-        noise: ImuNoise::from_model(&rec.model),
-        scale_factors: false,
+    let integration = IntegrationConfig {
         lever_arm: settings.lever_arm,
-        gate: Gate::Level(1e-4),
-        reset_after: 5,
-        propagation_interval: 1.0,
-        init_pos_std: prior.pos_std,
-        init_vel_std: prior.vel_std,
-        init_att_std: prior.att_std,
         baro: Some(settings.baro_bias),
-        init_sensor_std: prior
-            .bias_std
-            .map(|[g, a]| [g, a, Vector3::zeros(), Vector3::zeros()]),
+        ..IntegrationConfig::new(ImuNoise::from_model(&rec.model))
     };
-    let i0 = rec.sample_at(start.state.t);
-    let per_second = rec.per_second();
-    let mut integ = Integrator::new(M::start(Wgs84, start.state), Wgs84, cfg)
-        .with_estimates(start.estimates)
-        .with_smoother();
-    integ.prime(&rec.imu[i0]);
+    let cfg = SessionConfig {
+        filter: Some(prior.apply_to(FilterConfig {
+            baro_std: settings.baro_std,
+            smooth: true,
+            ..FilterConfig::new(integration)
+        })),
+        ..config(choice)
+    };
     let first_fix = rec.gnss.partition_point(|f| f.t <= start.state.t + 1e-9);
-    let mut fixes = rec.gnss[first_fix..].iter().copied().peekable();
-    let mut next_baro = first_after(&rec.baro, start.state.t);
-    let mut forward = Track::default();
-    let record = |integ: &mut Integrator<M, Wgs84>, track: &mut Track| {
-        integ.record_output();
-        let p = integ.covariance();
-        track
-            .epochs
-            .push(Epoch::of(integ.mechanization(), Some(integ.nav_std())));
-        track.sensors.push(SensorEpoch {
-            t: integ.state().t,
-            est: integ.estimates(),
-            gyro_std: std3(p, Layout::GYRO_BIAS),
-            accel_std: std3(p, Layout::ACCEL_BIAS),
-        });
-    };
-    record(&mut integ, &mut forward);
-    for (k, raw) in rec.imu[i0 + 1..].iter().enumerate() {
-        integ.step_with_fixes(raw, &mut fixes);
-        for &(t, h) in due(&rec.baro, &mut next_baro, raw.t, raw.dt) {
-            integ.update_baro(t, h, settings.baro_std);
-        }
-        if (k + 1) % per_second == 0 {
-            record(&mut integ, &mut forward);
-            bar.inc(1);
-        }
-    }
-    forward.rejected = integ.rejected.iter().map(|r| r.t).collect();
-    forward.seconds = clock.elapsed().as_secs_f64();
+    let (mut forward, finished) = run_session(rec, start, cfg, &rec.gnss[first_fix..], bar);
+    forward.sensors = finished
+        .snapshots
+        .iter()
+        .map(|s| SensorEpoch {
+            t: s.t,
+            est: s.estimates,
+            gyro_std: s.sensor_std[0],
+            accel_std: s.sensor_std[1],
+        })
+        .collect();
     let clock = Instant::now();
-    let smoothed = integ.smoothed();
-    let mut back = Track {
+    let smoothed = finished.smoothed.unwrap_or_default();
+    let back = Track {
         epochs: smoothed
             .iter()
             .map(|s| Epoch {
@@ -269,8 +234,7 @@ pub fn aided<M: AidedMechanization<Wgs84>>(
         sensors: Vec::new(),
         rejected: forward.rejected.clone(),
         baro: None,
-        seconds: 0.0,
+        seconds: forward.seconds + clock.elapsed().as_secs_f64(),
     };
-    back.seconds = forward.seconds + clock.elapsed().as_secs_f64();
     (forward, back)
 }

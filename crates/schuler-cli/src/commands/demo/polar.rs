@@ -11,9 +11,11 @@ use super::modes::{self, AidedSettings, Prior, Start};
 use super::{ModeRun, bar, errors};
 use anyhow::Result;
 use indicatif::MultiProgress;
-use schuler::earth::Wgs84;
-use schuler::nav::{LocalLevel, Wander};
+use schuler::session::MechanizationChoice;
 use std::time::Instant;
+
+/// Across the pole the all-latitude mechanization runs.
+const WANDER: MechanizationChoice = MechanizationChoice::Wander;
 
 /// The crossing, its recording and its runs.
 pub struct Polar {
@@ -50,6 +52,7 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
         vel_std,
         att_std,
         bias_std: None,
+        att_bias_cov: None,
     };
     let gains = modes::baro_gains(&start.state)?;
     let bars = [
@@ -58,10 +61,15 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
         bar(multi, "pole: NED, inertial", span),
     ];
     let ((forward, smoothed), inertial, ned) = std::thread::scope(|scope| {
-        let aided =
-            scope.spawn(|| modes::aided::<Wander<Wgs84>>(&rec, &start, &prior, settings, &bars[0]));
-        let inertial = modes::inertial::<Wander<Wgs84>>(&rec, &start, Some(gains), &bars[1]);
-        let ned = modes::inertial::<LocalLevel<Wgs84>>(&rec, &start, Some(gains), &bars[2]);
+        let aided = scope.spawn(|| modes::aided(&rec, &start, &prior, settings, WANDER, &bars[0]));
+        let inertial = modes::inertial(&rec, &start, Some(gains), WANDER, &bars[1]);
+        let ned = modes::inertial(
+            &rec,
+            &start,
+            Some(gains),
+            MechanizationChoice::Ned,
+            &bars[2],
+        );
         let aided = aided
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));

@@ -21,8 +21,7 @@
 //! narrower than a single run's spread; the Monte-Carlo test in the library
 //! (`tests/gnss_integration.rs`) is the sharp one.
 
-use super::aided_record::{InnovationRow, ReportSample, RunRecorder};
-use super::nav::MechanizationKind;
+use super::record::{InnovationRow, ReportSample};
 use crate::plot::{LineStyle, Plot};
 use crate::report::{Report, Table};
 use anyhow::{Context, Result};
@@ -32,6 +31,7 @@ use schuler::analysis::statistics::{Comparison, QUANTITIES, compare};
 use schuler::filter::integration::Counts;
 use schuler::filter::measurement::Kind;
 use schuler::filter::{GnssFix, Layout, SensorEstimates};
+use schuler::session::MechanizationKind;
 use schuler::units::{DEG_PER_H, MGAL, PPM};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
@@ -375,8 +375,10 @@ impl Ctx<'_> {
 pub struct ReportData<'a> {
     /// The run.
     pub facts: RunFacts<'a>,
-    /// What the recorder kept.
-    pub recorder: &'a RunRecorder<'a>,
+    /// Every tested measurement.
+    pub innovations: &'a [InnovationRow],
+    /// The filter's snapshots, once a second.
+    pub samples: &'a [ReportSample],
     /// The truths.
     pub settings: &'a ReportSettings,
 }
@@ -384,9 +386,9 @@ pub struct ReportData<'a> {
 /// Writes `consistency.json` and, if `html`, `report.html` with `report/`; returns
 /// the text to print.
 pub fn write(out: &Path, html: bool, data: &ReportData) -> Result<String> {
-    let nis = nis_by_kind(&data.recorder.innovations.rows);
+    let nis = nis_by_kind(data.innovations);
     let has_truth = data.settings.truth.is_some();
-    let nees = has_truth.then(|| nees_tests(&data.recorder.samples));
+    let nees = has_truth.then(|| nees_tests(data.samples));
     let path = out.join("consistency.json");
     let text = serde_json::to_string_pretty(&consistency_json(&nis, nees.as_ref()))?;
     std::fs::write(&path, text + "\n")
@@ -558,7 +560,7 @@ fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
         }
         s.table(t.caption("Largest errors inside each GNSS gap (INS bridging)"));
     }
-    super::compare::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
+    crate::output::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
     let t: Vec<f64> = cmp.errors.iter().map(|e| c.rel(e.t_sow)).collect();
     let ds: Vec<f64> = cmp.errors.iter().map(|e| e.horizontal()).collect();
     let dd: Vec<f64> = cmp.errors.iter().map(|e| e.pos_n.z).collect();
@@ -624,7 +626,7 @@ fn sensor_block(e: &SensorEstimates, block: usize) -> nalgebra::Vector3<f64> {
 
 fn sensor_section(r: &mut Report, c: &Ctx) -> Result<()> {
     let data = c.data;
-    let samples = &data.recorder.samples;
+    let samples = data.samples;
     let layout = data.facts.layout;
     let s = r.section("sensors", "Estimated sensor errors");
     s.paragraph(
@@ -778,7 +780,7 @@ fn components(kind: MechanizationKind, dof: usize) -> Vec<&'static str> {
 
 fn innovation_section(r: &mut Report, c: &Ctx) -> Result<()> {
     let data = c.data;
-    let rows = &data.recorder.innovations.rows;
+    let rows = &data.innovations;
     let s = r.section("innovations", "Innovations");
     s.paragraph(
         "Innovation z = computed − measured of every measurement in the filter's frame, \
@@ -878,7 +880,7 @@ fn bounds_plot(title: &str, y_label: &str, t: &[f64], v: &[f64], test: &ChiSquar
 
 fn nis_section(r: &mut Report, c: &Ctx, nis: &[KindConsistency]) -> Result<()> {
     let data = c.data;
-    let rows = &data.recorder.innovations.rows;
+    let rows = &data.innovations;
     let s = r.section("nis", "Consistency: normalized innovations (NIS)");
     s.paragraph(&format!(
         "NIS = zᵀ S⁻¹ z of each accepted measurement; for a consistent filter chi-square with \
@@ -912,7 +914,7 @@ fn nis_section(r: &mut Report, c: &Ctx, nis: &[KindConsistency]) -> Result<()> {
 
 fn nees_section(r: &mut Report, c: &Ctx, nees: &[Option<ChiSquareTest>; 3]) -> Result<()> {
     let data = c.data;
-    let samples = &data.recorder.samples;
+    let samples = data.samples;
     let s = r.section("nees", "Consistency: normalized estimation errors (NEES)");
     s.paragraph(
         "NEES = eᵀ P⁻¹ e of the position, velocity and attitude errors against the truth, \

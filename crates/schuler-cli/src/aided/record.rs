@@ -11,21 +11,13 @@
 //! m/s) and `sqrt(S_ii)`, the standard deviation the filter predicted for each
 //! component. Components past `dof` are empty.
 //!
-//! Once a second of the log's clock (the first epoch at or after each whole second)
-//! it also keeps a [`ReportSample`]: the estimated sensor errors with their standard
-//! deviations and, against a truth, the normalized estimation errors squared (NEES)
-//! of position, velocity and attitude from the filter's covariance at that instant.
+//! The report also takes the session's once-a-second [`ReportSample`]s: the estimated
+//! sensor errors with their standard deviations and, against a truth, the normalized
+//! estimation errors squared (NEES) of position, velocity and attitude.
 
-use super::nav::Decimator;
 use anyhow::{Context, Result, bail};
-use nalgebra::Vector3;
-use schuler::analysis::consistency::normalized_squared;
-use schuler::analysis::errors::{NavRecord, TruthAt, TruthCursor, errors_between};
-use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::Innovation;
 use schuler::filter::measurement::Kind;
-use schuler::filter::{Integrator, Layout, SensorEstimates};
-use schuler::nav::ErrorFrame;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -109,22 +101,12 @@ impl InnovationLog {
         })
     }
 
-    /// Takes the innovations the integrator recorded since the last call and writes
-    /// them (the integrator's record stays short whatever the run's length).
-    pub fn drain<M: ErrorFrame, E: EarthModel>(
-        &mut self,
-        integ: &mut Integrator<M, E>,
-    ) -> Result<()> {
-        if integ.innovations.is_empty() {
-            return Ok(());
-        }
-        for i in std::mem::take(&mut integ.innovations) {
-            self.push(InnovationRow::of(&i)?)?;
-        }
-        Ok(())
+    /// Writes one tested measurement and keeps it for the report.
+    pub fn push(&mut self, i: &Innovation) -> Result<()> {
+        self.push_row(InnovationRow::of(i)?)
     }
 
-    fn push(&mut self, r: InnovationRow) -> Result<()> {
+    fn push_row(&mut self, r: InnovationRow) -> Result<()> {
         use std::fmt::Write as _;
         self.line.clear();
         let _ = write!(
@@ -162,100 +144,8 @@ impl InnovationLog {
 }
 
 /// The filter's view of the sensor errors and, against a truth, its NEES, at one
-/// instant.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ReportSample {
-    /// Time [s].
-    pub t: f64,
-    /// Estimated sensor errors.
-    pub estimates: SensorEstimates,
-    /// Standard deviations of gyro bias [rad/s], accelerometer bias [m/s^2], gyro and
-    /// accelerometer scale factors (zero where not estimated).
-    pub sensor_std: [Vector3<f64>; 4],
-    /// Standard deviation of the barometer bias [m], when estimated.
-    pub baro_std: Option<f64>,
-    /// NEES of position, velocity and attitude (3 dof each): `None` without a truth
-    /// at this time; an entry `None` where the covariance block is not positive
-    /// definite.
-    pub nees: Option<[Option<f64>; 3]>,
-}
-
-/// Takes a [`ReportSample`] once a second and keeps the innovation log.
-pub struct RunRecorder<'a> {
-    /// Every tested measurement.
-    pub innovations: InnovationLog,
-    /// The samples, in time order.
-    pub samples: Vec<ReportSample>,
-    truth: &'a [NavRecord],
-    cursor: TruthCursor,
-    cadence: Decimator,
-}
-
-impl<'a> RunRecorder<'a> {
-    /// Starts recording into `dir`; with a `truth` (sorted by time; empty: none) the
-    /// samples carry NEES.
-    pub fn create(dir: &Path, truth: &'a [NavRecord]) -> Result<Self> {
-        Ok(Self {
-            innovations: InnovationLog::create(dir)?,
-            samples: Vec::new(),
-            truth,
-            cursor: TruthCursor::default(),
-            cadence: Decimator::new(Some(1.0)),
-        })
-    }
-
-    /// After a sample ending at `t` with interval `dt`: log the new innovations and,
-    /// at the first epoch of each second, take a sample.
-    pub fn after_sample<M: ErrorFrame, E: EarthModel>(
-        &mut self,
-        integ: &mut Integrator<M, E>,
-        t: f64,
-        dt: f64,
-    ) -> Result<()> {
-        self.innovations.drain(integ)?;
-        if self.cadence.take(t, dt) {
-            self.sample(integ);
-        }
-        Ok(())
-    }
-
-    /// Takes a sample now.
-    pub fn sample<M: ErrorFrame, E: EarthModel>(&mut self, integ: &Integrator<M, E>) {
-        let p = integ.covariance();
-        let l = integ.layout();
-        let std3 =
-            |o: Option<usize>| o.map_or(Vector3::zeros(), |o| schuler::filter::kalman::std3(p, o));
-        let state = integ.state();
-        let nees = if self.truth.is_empty() {
-            None
-        } else {
-            match self.cursor.at(self.truth, state.t) {
-                TruthAt::Exact(truth) | TruthAt::Interpolated(truth, _) => {
-                    let e = errors_between(&Wgs84, &state, &(&truth).into());
-                    let [pp, pv, pa] = integ.nav_covariance();
-                    Some([
-                        normalized_squared(&e.pos_n, &pp),
-                        normalized_squared(&e.v_n, &pv),
-                        normalized_squared(&e.psi, &pa),
-                    ])
-                }
-                TruthAt::Before | TruthAt::After => None,
-            }
-        };
-        self.samples.push(ReportSample {
-            t: state.t,
-            estimates: integ.estimates(),
-            sensor_std: [
-                std3(Some(Layout::GYRO_BIAS)),
-                std3(Some(Layout::ACCEL_BIAS)),
-                std3(l.gyro_scale),
-                std3(l.accel_scale),
-            ],
-            baro_std: l.baro_bias.map(|b| p[(b, b)].max(0.0).sqrt()),
-            nees,
-        });
-    }
-}
+/// instant (the session's snapshot, taken once a second).
+pub use schuler::session::Snapshot as ReportSample;
 
 #[cfg(test)]
 mod tests {
@@ -274,7 +164,7 @@ mod tests {
             nis: 1.0,
             accepted: true,
         };
-        log.push(InnovationRow::of(&baro).expect("1 component"))
+        log.push_row(InnovationRow::of(&baro).expect("1 component"))
             .expect("write");
         let pos = Innovation {
             t: 13.0,
@@ -284,7 +174,7 @@ mod tests {
             nis: 1.5,
             accepted: false,
         };
-        log.push(InnovationRow::of(&pos).expect("3 components"))
+        log.push_row(InnovationRow::of(&pos).expect("3 components"))
             .expect("write");
         log.finish().expect("flush");
         let text = std::fs::read_to_string(dir.path().join("innovations.csv")).expect("read");

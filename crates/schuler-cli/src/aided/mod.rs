@@ -1,0 +1,660 @@
+//! Aiding of `schuler nav` (`--gnss`, `--baro`, vehicle aids): the options as written
+//! ([`AidingOptions`], flags or a `[aiding]` table), checked and loaded into an
+//! [`Aiding`]: the session's filter configuration and the readings the run pushes as
+//! aids. [`report`] writes the consistency report, [`record`] `innovations.csv`,
+//! [`vehicle`] resolves the vehicle aids.
+
+pub mod record;
+pub mod report;
+pub mod vehicle;
+
+use crate::options::{Triple, quantity};
+use anyhow::{Context, Result, bail};
+use nalgebra::Vector3;
+use report::ReportSettings;
+use schuler::filter::{GnssFix, ImuNoise, IntegrationConfig, SensorEstimates};
+use schuler::session::FilterConfig;
+use schuler::units::{Dimension, parse_as_or_si};
+use std::path::{Path, PathBuf};
+use vehicle::VehicleReadings;
+
+/// File names of an aided run's outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputNames {
+    /// Navigation result (KF-GINS text).
+    pub nav: &'static str,
+    /// Standard deviations.
+    pub std: &'static str,
+    /// Sensor errors.
+    pub imu_err: &'static str,
+}
+
+impl OutputNames {
+    /// schuler's own names.
+    pub const SCHULER: OutputNames = OutputNames {
+        nav: "nav.txt",
+        std: "std.txt",
+        imu_err: "imu_err.txt",
+    };
+    /// KF-GINS's names.
+    pub const KF_GINS: OutputNames = OutputNames {
+        nav: "KF_GINS_Navresult.nav",
+        std: "KF_GINS_STD.txt",
+        imu_err: "KF_GINS_IMU_ERR.txt",
+    };
+}
+
+/// Barometer readings `(t, h)` and the `(noise, bias prior)` standard deviations [m].
+type BaroInput = (Vec<(f64, f64)>, Option<(f64, f64)>);
+
+/// What aiding a run has: the filter and the readings pushed as aids.
+#[derive(Debug, Clone)]
+pub struct Aiding {
+    /// GNSS fixes in time order.
+    pub fixes: Vec<GnssFix>,
+    /// The session's filter (noise, prior, gate, barometer, smoother, vehicle aids).
+    pub filter: FilterConfig,
+    /// Output file names.
+    pub names: OutputNames,
+    /// Sensor errors known at the start (removed from the first sample on).
+    pub initial_errors: SensorEstimates,
+    /// Test outages (GNSS removed inside), with the truth to report against.
+    pub outage_test: Option<OutageTest>,
+    /// Barometer readings `(t, h)`.
+    pub baro: Vec<(f64, f64)>,
+    /// The report: whether to write `report.html`, and the truths it compares with.
+    pub report: ReportSettings,
+    /// Rest intervals, odometer and heading readings.
+    pub vehicle: VehicleReadings,
+}
+
+/// The outage test of `--outage-test`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutageTest {
+    /// The outages [s].
+    pub windows: Vec<(f64, f64)>,
+    /// Truth to report the errors against.
+    pub truth: Option<PathBuf>,
+}
+
+/// The aiding options of `schuler nav`, as written (flags, or a `[aiding]` table in
+/// the TOML config).
+#[derive(clap::Args, Debug, Default, Clone, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AidingOptions {
+    /// GNSS position log: KF-GINS text (t lat lon h std_n std_e std_d [vn ve vd
+    /// std_vn std_ve std_vd], whose velocities are then used) or CSV whose header names
+    /// t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m (as `schuler simulate`'s gnss.csv;
+    /// its velocity columns are used only through --gnss-vel, its outlier flag never).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub gnss: Option<PathBuf>,
+    /// GNSS velocity log matched to the fixes by time: text t vn ve vd [std_vn std_ve
+    /// std_vd] or CSV naming t,vn_mps,ve_mps,vd_mps[,std_vn_mps,...] (gnss.csv too); a
+    /// position log given here is an error.
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub gnss_vel: Option<PathBuf>,
+    /// Velocity standard deviation where the velocity log gives none (default 0.1 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub gnss_vel_std: Option<String>,
+    /// Antenna position in body axes, front, right, down [m].
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
+    pub lever_arm: Option<Triple>,
+    /// Innovation gate: significance level of the chi-square test (default 1e-4; 0
+    /// turns the gate off).
+    #[arg(long, allow_hyphen_values = true, value_name = "ALPHA")]
+    pub gate: Option<f64>,
+    /// Estimate gyro and accelerometer scale factors (21 states).
+    #[arg(long)]
+    #[serde(default)]
+    pub scale_factors: bool,
+    /// Also write the Rauch–Tung–Striebel smoothed trajectory (forward-backward) at
+    /// the output rate into `OUT/smoothed/` (the forward result stays in `OUT/`).
+    #[arg(long)]
+    #[serde(default)]
+    pub smooth: bool,
+    /// Angle random walk (e.g. `0.1 deg/sqrt(h)`; default from --imu-grade).
+    #[arg(long, allow_hyphen_values = true, value_name = "ARW")]
+    pub arw: Option<String>,
+    /// Velocity random walk (e.g. `0.08 m/s/sqrt(h)`).
+    #[arg(long, allow_hyphen_values = true, value_name = "VRW")]
+    pub vrw: Option<String>,
+    /// Gyro bias standard deviation (e.g. `2 deg/h`).
+    #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    pub gyro_bias_std: Option<String>,
+    /// Accelerometer bias standard deviation (e.g. `300 mGal`).
+    #[arg(long, allow_hyphen_values = true, value_name = "ACCEL")]
+    pub accel_bias_std: Option<String>,
+    /// Gyro scale-factor standard deviation (e.g. `1000 ppm`; with --scale-factors).
+    #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    pub gyro_scale_std: Option<String>,
+    /// Accelerometer scale-factor standard deviation.
+    #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    pub accel_scale_std: Option<String>,
+    /// Bias instability (Gauss–Markov std, e.g. `0.2 deg/h` and `2e-4 m/s^2`) with
+    /// --bias-corr-time: sets the bias random walk.
+    #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    pub gyro_bias_instability: Option<String>,
+    /// Accelerometer bias instability.
+    #[arg(long, allow_hyphen_values = true, value_name = "ACCEL")]
+    pub accel_bias_instability: Option<String>,
+    /// Correlation time of the bias instability (default 1 h); given, the biases are
+    /// modelled as first-order Gauss–Markov processes, otherwise as random walks.
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub bias_corr_time: Option<String>,
+    /// Initial position standard deviation north, east, down [m] (default 1,1,1).
+    #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
+    pub init_pos_std: Option<Triple>,
+    /// Initial velocity standard deviation [m/s] (default 0.1,0.1,0.1).
+    #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
+    pub init_vel_std: Option<Triple>,
+    /// Initial attitude standard deviation roll, pitch, yaw [deg] (default 0.1,0.1,0.5).
+    #[arg(long, allow_hyphen_values = true, value_name = "R,P,Y")]
+    pub init_att_std: Option<Triple>,
+    /// Barometer log (`baro.csv` of `schuler simulate`: t,h_m; or `t h` rows): height
+    /// aiding with a bias state.
+    #[arg(long, value_name = "FILE")]
+    pub baro: Option<PathBuf>,
+    /// Barometer noise standard deviation (default 0.5 m).
+    #[arg(long, allow_hyphen_values = true, value_name = "LENGTH")]
+    pub baro_std: Option<String>,
+    /// Prior standard deviation of the barometer bias (default 10 m).
+    #[arg(long, allow_hyphen_values = true, value_name = "LENGTH")]
+    pub baro_bias_std: Option<String>,
+    /// Outage test: remove GNSS for LEN every PERIOD (e.g. `60s/180s`), the first
+    /// outage starting at --outage-start (default: one PERIOD after the first fix);
+    /// with --truth, report the errors at the end of and inside each outage.
+    #[arg(long, allow_hyphen_values = true, value_name = "LEN/PERIOD")]
+    pub outage_test: Option<String>,
+    /// Start of the first test outage [s, the log's clock].
+    #[arg(long, allow_hyphen_values = true, value_name = "SOW")]
+    pub outage_start: Option<f64>,
+    /// Truth (KF-GINS navigation text or schuler CSV): the report's position errors
+    /// and NEES, and the outage test's errors.
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub truth: Option<PathBuf>,
+    /// Truth of the sensor errors for the report, in imu_err.txt's layout (`t`, gyro
+    /// bias [deg/h], accelerometer bias [mGal], optionally scale factors [ppm]).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub sensor_truth: Option<PathBuf>,
+    /// Do not write report.html and report/ (innovations.csv and consistency.json are
+    /// always written).
+    #[arg(long)]
+    #[serde(default)]
+    pub no_report: bool,
+    /// Longest covariance propagation step (default 1 s; the covariance is always
+    /// propagated to each measurement's time).
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub propagation_interval: Option<String>,
+    /// Zero-velocity updates inside the rest intervals of FILE (`t0 t1` per line).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_name = "FILE",
+        conflicts_with = "zupt_detect"
+    )]
+    pub zupt: Option<PathBuf>,
+    /// Zero-velocity updates where the IMU data look at rest (the alignment's motion
+    /// detector on a 1-s window, specific force against gravity, rate against the
+    /// Earth's) and the navigation's speed is below --zupt-max-speed.
+    #[arg(long)]
+    #[serde(default)]
+    pub zupt_detect: bool,
+    /// Zero-velocity standard deviation (default 0.02 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub zupt_std: Option<String>,
+    /// Time between zero-velocity updates at rest, and the detector's block
+    /// (default 0.1 s; the detector's window is ten blocks).
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub zupt_interval: Option<String>,
+    /// --zupt-detect: no update while the navigation's speed exceeds this (an IMU
+    /// cannot tell rest from constant velocity; default 0.5 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub zupt_max_speed: Option<String>,
+    /// With each zero-velocity update, a zero-angular-rate update on the gyro biases
+    /// (the body turns with the Earth only).
+    #[arg(long)]
+    #[serde(default)]
+    pub zaru: bool,
+    /// Standard deviation of the rate averaged over --zupt-interval (default: the angle
+    /// random walk over that time, ARW/sqrt(interval)).
+    #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    pub zaru_std: Option<String>,
+    /// Non-holonomic constraint of a land vehicle: no lateral or vertical velocity of
+    /// the vehicle frame at --vehicle-lever-arm.
+    #[arg(long)]
+    #[serde(default)]
+    pub nhc: bool,
+    /// NHC standard deviation (default 0.1 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub nhc_std: Option<String>,
+    /// Time between NHC updates (default 0.1 s).
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub nhc_interval: Option<String>,
+    /// Odometer log (`t speed` per line, forward speed in m/s at --vehicle-lever-arm).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub odometer: Option<PathBuf>,
+    /// Odometer speed standard deviation (default 0.05 m/s).
+    #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    pub odometer_std: Option<String>,
+    /// Estimate the odometer's scale factor with this prior standard deviation (e.g.
+    /// `1 %`).
+    #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    pub odometer_scale_std: Option<String>,
+    /// Mounting angles: the vehicle frame's roll, pitch, yaw relative to the IMU body
+    /// [deg] (0,0,0 when the IMU's axes are the vehicle's front, right, down).
+    #[arg(long, allow_hyphen_values = true, value_name = "R,P,Y")]
+    pub mounting_angles: Option<Triple>,
+    /// The point the NHC and the odometer speak of (the rear axle's centre, the
+    /// odometer wheel) in IMU body axes, front, right, down [m] (default 0,0,0).
+    #[arg(long, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    pub vehicle_lever_arm: Option<Triple>,
+    /// Dual-antenna GNSS headings (`t heading std [pitch pitch_std]`, degrees).
+    #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
+    pub dual_antenna: Option<PathBuf>,
+    /// Azimuth of the antenna baseline (from the first antenna to the second) from
+    /// the IMU's front axis towards its right [deg] (default 0).
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub dual_antenna_baseline_yaw: Option<f64>,
+    /// Elevation of the baseline above the IMU's front-right plane [deg] (default 0).
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub dual_antenna_baseline_pitch: Option<f64>,
+}
+
+impl AidingOptions {
+    /// `self` with missing fields taken from `other`.
+    pub fn or(self, other: AidingOptions) -> AidingOptions {
+        macro_rules! pick {
+            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth, no_report: self.no_report || other.no_report, zupt_detect: self.zupt_detect || other.zupt_detect, zaru: self.zaru || other.zaru, nhc: self.nhc || other.nhc } };
+        }
+        pick!(
+            gnss,
+            gnss_vel,
+            gnss_vel_std,
+            lever_arm,
+            gate,
+            arw,
+            vrw,
+            gyro_bias_std,
+            accel_bias_std,
+            gyro_scale_std,
+            accel_scale_std,
+            gyro_bias_instability,
+            accel_bias_instability,
+            bias_corr_time,
+            init_pos_std,
+            init_vel_std,
+            init_att_std,
+            baro,
+            baro_std,
+            baro_bias_std,
+            outage_test,
+            outage_start,
+            truth,
+            sensor_truth,
+            propagation_interval,
+            zupt,
+            zupt_std,
+            zupt_interval,
+            zupt_max_speed,
+            zaru_std,
+            nhc_std,
+            nhc_interval,
+            odometer,
+            odometer_std,
+            odometer_scale_std,
+            mounting_angles,
+            vehicle_lever_arm,
+            dual_antenna,
+            dual_antenna_baseline_yaw,
+            dual_antenna_baseline_pitch
+        )
+    }
+
+    /// Paths relative to `base` (a config file's folder).
+    pub fn relative_to(mut self, base: &Path) -> Self {
+        for p in [
+            &mut self.gnss,
+            &mut self.gnss_vel,
+            &mut self.truth,
+            &mut self.sensor_truth,
+            &mut self.baro,
+            &mut self.zupt,
+            &mut self.odometer,
+            &mut self.dual_antenna,
+        ]
+        .into_iter()
+        .flatten()
+        {
+            if p.is_relative() {
+                *p = base.join(&*p);
+            }
+        }
+        self
+    }
+
+    /// Whether any aiding source is given (GNSS, barometer or a vehicle aid).
+    pub fn any(&self) -> bool {
+        self.gnss.is_some()
+            || self.baro.is_some()
+            || self.zupt.is_some()
+            || self.zupt_detect
+            || self.nhc
+            || self.odometer.is_some()
+            || self.dual_antenna.is_some()
+    }
+
+    /// Load the aiding data and check every value; `None` without any aiding source
+    /// ([`AidingOptions::any`]).
+    pub fn resolve(&self, noise: schuler::filter::ImuNoise) -> Result<Option<Aiding>> {
+        if self.gnss.is_none() && self.gnss_vel.is_some() {
+            bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
+        }
+        vehicle::check_dependencies(self)?;
+        if !self.any() {
+            return Ok(None);
+        }
+        let mut fixes = self.fixes()?;
+        let noise = self.noise(noise)?;
+        let outage_test = self.outage_test(&mut fixes)?;
+        let (baro, baro_std) = self.baro()?;
+        let (vehicle_cfg, vehicle) = vehicle::resolve(self, &noise)?;
+        let mut integration = self.integration(noise)?;
+        integration.baro = baro_std.map(|(_, bias)| (bias, 0.0));
+        Ok(Some(Aiding {
+            vehicle,
+            filter: FilterConfig {
+                integration,
+                baro_std: baro_std.map_or(0.5, |(std, _)| std),
+                smooth: self.smooth,
+                vehicle: vehicle_cfg,
+                att_bias_cov: None,
+            },
+            names: OutputNames::SCHULER,
+            initial_errors: Default::default(),
+            outage_test,
+            baro,
+            report: self.report()?,
+            fixes,
+        }))
+    }
+
+    /// The GNSS fixes, with the velocities of `--gnss-vel` merged in.
+    fn fixes(&self) -> Result<Vec<GnssFix>> {
+        let mut fixes = match &self.gnss {
+            Some(gnss) => crate::formats::gnss::read_gnss(gnss)?,
+            None => Vec::new(),
+        };
+        if let Some(v) = &self.gnss_vel {
+            let std =
+                quantity("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
+            if std <= 0.0 {
+                bail!("--gnss-vel-std must be positive");
+            }
+            let unmatched = crate::formats::gnss::merge_velocity(&mut fixes, v, std)?;
+            if unmatched > 0 {
+                eprintln!(
+                    "warning: {}: {unmatched} velocity epochs have no position fix at the same time and are not used",
+                    v.display()
+                );
+            }
+        }
+        Ok(fixes)
+    }
+
+    /// The IMU noise model with the flags' overrides.
+    fn noise(&self, mut noise: ImuNoise) -> Result<ImuNoise> {
+        let q = quantity;
+        let set = |v: &mut Vector3<f64>, x: Option<f64>| {
+            if let Some(x) = x {
+                *v = Vector3::repeat(x);
+            }
+        };
+        set(
+            &mut noise.arw,
+            q("arw", &self.arw, Dimension::AngleRandomWalk)?,
+        );
+        set(
+            &mut noise.vrw,
+            q("vrw", &self.vrw, Dimension::VelocityRandomWalk)?,
+        );
+        set(
+            &mut noise.gyro_bias,
+            q("gyro-bias-std", &self.gyro_bias_std, Dimension::AngularRate)?,
+        );
+        set(
+            &mut noise.accel_bias,
+            q(
+                "accel-bias-std",
+                &self.accel_bias_std,
+                Dimension::Acceleration,
+            )?,
+        );
+        set(
+            &mut noise.gyro_scale,
+            q(
+                "gyro-scale-std",
+                &self.gyro_scale_std,
+                Dimension::Dimensionless,
+            )?,
+        );
+        set(
+            &mut noise.accel_scale,
+            q(
+                "accel-scale-std",
+                &self.accel_scale_std,
+                Dimension::Dimensionless,
+            )?,
+        );
+        let tau_given = q("bias-corr-time", &self.bias_corr_time, Dimension::Time)?;
+        let tau = tau_given.unwrap_or(3600.0);
+        if tau <= 0.0 {
+            bail!("--bias-corr-time must be positive");
+        }
+        if tau_given.is_some() {
+            // A correlation time makes the biases Gauss–Markov (as KF-GINS models them).
+            noise.gyro_bias_tau = tau;
+            noise.accel_bias_tau = tau;
+        }
+        let walk = |x: f64| Vector3::repeat(x * (2.0 / tau).sqrt());
+        let gyro = q(
+            "gyro-bias-instability",
+            &self.gyro_bias_instability,
+            Dimension::AngularRate,
+        )?;
+        if let Some(x) = gyro {
+            noise.gyro_bias_walk = walk(x);
+        }
+        let accel = q(
+            "accel-bias-instability",
+            &self.accel_bias_instability,
+            Dimension::Acceleration,
+        )?;
+        if let Some(x) = accel {
+            noise.accel_bias_walk = walk(x);
+        }
+        Ok(noise)
+    }
+
+    /// `--outage-test LEN/PERIOD`: the windows, with the fixes inside them removed.
+    fn outage_test(&self, fixes: &mut Vec<GnssFix>) -> Result<Option<OutageTest>> {
+        let Some(text) = &self.outage_test else {
+            return Ok(None);
+        };
+        let (len, period) = text.split_once('/').with_context(|| {
+            format!("--outage-test {text:?}: expected LEN/PERIOD, e.g. 60s/180s")
+        })?;
+        let t = |s: &str| -> Result<f64> {
+            parse_as_or_si(s.trim(), Dimension::Time)
+                .with_context(|| format!("--outage-test {text:?}"))
+        };
+        let (len, period) = (t(len)?, t(period)?);
+        if !(len > 0.0 && period > len) {
+            bail!("--outage-test {text:?}: need 0 < LEN < PERIOD");
+        }
+        let (first, last) = (
+            fixes.first().map_or(0.0, |f| f.t),
+            fixes.last().map_or(0.0, |f| f.t),
+        );
+        let mut start = self.outage_start.unwrap_or(first + period);
+        let mut windows = Vec::new();
+        while start + len <= last {
+            windows.push((start, start + len));
+            start += period;
+        }
+        if windows.is_empty() {
+            bail!(
+                "--outage-test {text:?}: no whole outage fits between the first and last GNSS fix"
+            );
+        }
+        fixes.retain(|f| !windows.iter().any(|&(a, b)| f.t > a && f.t <= b));
+        Ok(Some(OutageTest {
+            windows,
+            truth: self.truth.clone(),
+        }))
+    }
+
+    /// The barometer's readings `(t, h)` and `(noise, bias prior)` standard
+    /// deviations [m].
+    fn baro(&self) -> Result<BaroInput> {
+        let Some(path) = &self.baro else {
+            return Ok((Vec::new(), None));
+        };
+        let readings = crate::formats::gnss::read_baro(path)?;
+        let std = quantity("baro-std", &self.baro_std, Dimension::Length)?.unwrap_or(0.5);
+        let bias =
+            quantity("baro-bias-std", &self.baro_bias_std, Dimension::Length)?.unwrap_or(10.0);
+        if std <= 0.0 || bias <= 0.0 {
+            bail!("--baro-std and --baro-bias-std must be positive");
+        }
+        Ok((readings, Some((std, bias))))
+    }
+
+    /// The filter's settings (without the barometer).
+    fn integration(&self, noise: ImuNoise) -> Result<IntegrationConfig> {
+        let gate = match self.gate {
+            None => schuler::filter::Gate::Level(1e-4),
+            Some(0.0) => schuler::filter::Gate::Off,
+            Some(a) if a > 0.0 && a < 1.0 => schuler::filter::Gate::Level(a),
+            Some(a) => bail!("--gate must be a significance level in [0, 1), got {a}"),
+        };
+        let triple = |flag: &str, v: &Option<Triple>, default: [f64; 3]| -> Result<Vector3<f64>> {
+            let t = v.map_or(default, |t| t.0);
+            if t.iter().any(|x| *x <= 0.0) {
+                bail!("--{flag} must be positive, got {t:?}");
+            }
+            Ok(Vector3::from(t))
+        };
+        let att = triple("init-att-std", &self.init_att_std, [0.1, 0.1, 0.5])?;
+        let propagation_interval = quantity(
+            "propagation-interval",
+            &self.propagation_interval,
+            Dimension::Time,
+        )?
+        .unwrap_or(1.0);
+        if propagation_interval <= 0.0 {
+            bail!("--propagation-interval must be positive");
+        }
+        Ok(IntegrationConfig {
+            noise,
+            scale_factors: self.scale_factors,
+            lever_arm: self
+                .lever_arm
+                .map_or(Vector3::zeros(), |t| Vector3::from(t.0)),
+            gate,
+            reset_after: 5,
+            propagation_interval,
+            init_pos_std: triple("init-pos-std", &self.init_pos_std, [1.0, 1.0, 1.0])?,
+            init_vel_std: triple("init-vel-std", &self.init_vel_std, [0.1, 0.1, 0.1])?,
+            // Roll, pitch, yaw std taken about north, east, down (level attitude).
+            init_att_std: att.map(f64::to_radians),
+            init_sensor_std: None,
+            baro: None,
+        })
+    }
+
+    /// The report's settings and truths.
+    fn report(&self) -> Result<ReportSettings> {
+        Ok(ReportSettings {
+            html: !self.no_report,
+            truth: match &self.truth {
+                Some(p) => Some((p.clone(), crate::formats::nav::read_nav(p)?.1)),
+                None => None,
+            },
+            sensor_truth: match &self.sensor_truth {
+                Some(p) => crate::formats::sensor_errors::read_sensor_errors(p)?,
+                None => Vec::new(),
+            },
+        })
+    }
+}
+
+/// The outage test's report: the outages, and with a truth the largest horizontal,
+/// vertical and attitude errors inside each (for an INS bridging a gap, the error at
+/// its end) and the RMS of those maxima, the protocol of the KF-GINS paper; also
+/// written to `DIR/outage_test.json`.
+pub fn report_outage_test(
+    nav: &Path,
+    windows: &[(f64, f64)],
+    truth: Option<&Path>,
+    dir: &Path,
+) -> Result<()> {
+    println!(
+        "outage test: {} outages of {:.0} s",
+        windows.len(),
+        windows[0].1 - windows[0].0
+    );
+    let Some(truth) = truth else {
+        println!("  (give --truth FILE for the errors in each outage)");
+        return Ok(());
+    };
+    let (_, nav_rows) = crate::formats::nav::read_nav(nav)?;
+    let (_, truth_rows) = crate::formats::nav::read_nav(truth)?;
+    let c = schuler::analysis::statistics::compare(&nav_rows, &truth_rows, None, None, windows)?;
+    let mut json = Vec::new();
+    println!(
+        "  outage [s]          | horizontal max [m] | vertical max [m] | roll/pitch/yaw max [deg]"
+    );
+    for o in &c.stats.outages {
+        println!(
+            "  {:9.1}-{:9.1} | {:18.3} | {:16.3} | {:.4} {:.4} {:.4}",
+            o.from_sow,
+            o.to_sow,
+            o.horizontal,
+            o.vertical,
+            o.att.roll.to_degrees(),
+            o.att.pitch.to_degrees(),
+            o.att.yaw.to_degrees()
+        );
+        json.push(serde_json::json!({
+            "from": o.from_sow, "to": o.to_sow, "epochs": o.epochs,
+            "horizontal_max_m": o.horizontal, "vertical_max_m": o.vertical,
+            "roll_max_deg": o.att.roll.to_degrees(), "pitch_max_deg": o.att.pitch.to_degrees(),
+            "yaw_max_deg": o.att.yaw.to_degrees(),
+        }));
+    }
+    let rms = c.stats.outage_rms.map(|o| {
+        println!(
+            "  RMS of the maxima  | {:18.3} | {:16.3} | {:.4} {:.4} {:.4}",
+            o.horizontal,
+            o.vertical,
+            o.att.roll.to_degrees(),
+            o.att.pitch.to_degrees(),
+            o.att.yaw.to_degrees()
+        );
+        serde_json::json!({
+            "horizontal_m": o.horizontal, "vertical_m": o.vertical,
+            "roll_deg": o.att.roll.to_degrees(), "pitch_deg": o.att.pitch.to_degrees(),
+            "yaw_deg": o.att.yaw.to_degrees(),
+        })
+    });
+    let path = dir.join("outage_test.json");
+    let text = serde_json::to_string_pretty(
+        &serde_json::json!({ "outages": json, "rms_of_maxima": rms }),
+    )?;
+    std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,315 @@
+//! Drives a library [`Session`] from a file's samples and streams what comes out to
+//! the output files: `nav.txt`/`nav.csv` for every run; with the filter `std.txt` and
+//! `imu_err.txt` (KF-GINS's column layouts) at the output epochs, `innovations.csv` as
+//! the measurements come, and `rejected.csv` at the end (every measurement the gate
+//! refused, that fell outside the IMU data, came too late or had no use, with time and
+//! reason). On a read error everything computed so far is written before the error is
+//! returned.
+
+use crate::aided::record::InnovationLog;
+use crate::formats::InputError;
+use crate::output::{NavEpoch, NavWriter, push_fixed};
+use anyhow::{Context, Result};
+use schuler::earth::EarthModel;
+use schuler::filter::SensorEstimates;
+use schuler::filter::integration::SkipReason;
+use schuler::filter::smoother::Smoothed;
+use schuler::imu::ImuSample;
+use schuler::session::{Epoch, Event, Finished, Session};
+use schuler::units::{DEG_PER_H, MGAL, PPM};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Text writer for `std.txt` and `imu_err.txt`.
+pub struct Table {
+    w: BufWriter<File>,
+    path: PathBuf,
+    line: Vec<u8>,
+}
+
+impl Table {
+    /// Creates `dir/name`.
+    pub fn create(dir: &Path, name: &str) -> Result<Self> {
+        let path = dir.join(name);
+        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+        Ok(Self {
+            w: BufWriter::with_capacity(1 << 16, f),
+            path,
+            line: Vec::with_capacity(512),
+        })
+    }
+
+    /// One row: time, then the values.
+    pub fn row(&mut self, t: f64, values: &[f64]) -> Result<()> {
+        self.line.clear();
+        push_table_row(&mut self.line, t, values);
+        self.w
+            .write_all(&self.line)
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+
+    /// Flushes the file.
+    pub fn finish(mut self) -> Result<()> {
+        self.w
+            .flush()
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+/// A line of `std.txt` or `imu_err.txt`: time to 1 µs, then the values to 9 decimals,
+/// space-separated.
+pub fn push_table_row(line: &mut Vec<u8>, t: f64, values: &[f64]) {
+    push_fixed(line, t, 6);
+    for v in values {
+        line.push(b' ');
+        push_fixed(line, *v, 9);
+    }
+    line.push(b'\n');
+}
+
+/// The KF-GINS IMU_ERR columns after time: gyro bias [deg/h], accelerometer bias
+/// [mGal], gyro and accelerometer scale factors [ppm].
+pub fn imu_err_row(e: &SensorEstimates) -> Vec<f64> {
+    let mut row = Vec::with_capacity(12);
+    row.extend(e.gyro_bias.iter().map(|x| x / DEG_PER_H));
+    row.extend(e.accel_bias.iter().map(|x| x / MGAL));
+    row.extend(e.gyro_scale.iter().map(|x| x / PPM));
+    row.extend(e.accel_scale.iter().map(|x| x / PPM));
+    row
+}
+
+/// The filter's output files.
+pub struct FilterFiles {
+    std: Table,
+    err: Table,
+    /// Every tested measurement (`innovations.csv`), kept for the report.
+    pub innovations: InnovationLog,
+    /// `rejected.csv`'s rows with their times, in event order.
+    refused: Vec<(f64, String)>,
+}
+
+impl FilterFiles {
+    /// Creates `std_name`, `err_name` and `innovations.csv` in `dir`.
+    pub fn create(dir: &Path, std_name: &str, err_name: &str) -> Result<Self> {
+        Ok(Self {
+            std: Table::create(dir, std_name)?,
+            err: Table::create(dir, err_name)?,
+            innovations: InnovationLog::create(dir)?,
+            refused: Vec::new(),
+        })
+    }
+
+    /// Flushes the tables and writes `dir/rejected.csv` (rows sorted by time).
+    pub fn finish(mut self, dir: &Path) -> Result<InnovationLog> {
+        self.std.finish()?;
+        self.err.finish()?;
+        self.innovations.finish()?;
+        let mut s = String::from("t,measurement,reason,nis,threshold\n");
+        self.refused.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (_, r) in &self.refused {
+            s.push_str(r);
+        }
+        let path = dir.join("rejected.csv");
+        std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(self.innovations)
+    }
+}
+
+/// Where a run's output goes.
+pub struct Outputs {
+    /// The navigation result.
+    pub nav: NavWriter,
+    /// The filter's files, when a filter runs.
+    pub filter: Option<FilterFiles>,
+    last_written: f64,
+}
+
+impl Outputs {
+    /// Writes `nav` and, with a filter, `filter`.
+    pub fn new(nav: NavWriter, filter: Option<FilterFiles>) -> Self {
+        Self {
+            nav,
+            filter,
+            last_written: f64::NAN,
+        }
+    }
+
+    fn epoch(&mut self, e: &Epoch) -> Result<()> {
+        self.nav.write_epoch(&NavEpoch {
+            state: e.state,
+            r_e: e.r_e,
+            wander_azimuth: e.wander_azimuth,
+        })?;
+        self.last_written = e.state.t;
+        if let (Some(files), Some(f)) = (self.filter.as_mut(), &e.filter) {
+            let [sp, sv, sa] = f.nav_std;
+            let [gb, ab, gs, as_] = f.sensor_std;
+            let mut row = Vec::with_capacity(21);
+            row.extend_from_slice(sp.as_slice());
+            row.extend_from_slice(sv.as_slice());
+            row.extend(sa.iter().map(|x| x.to_degrees()));
+            row.extend(gb.iter().map(|x| x / DEG_PER_H));
+            row.extend(ab.iter().map(|x| x / MGAL));
+            row.extend(gs.iter().map(|x| x / PPM));
+            row.extend(as_.iter().map(|x| x / PPM));
+            files.std.row(e.state.t, &row)?;
+            files.err.row(e.state.t, &imu_err_row(&f.estimates))?;
+        }
+        Ok(())
+    }
+
+    fn event(&mut self, e: Event) -> Result<()> {
+        let Some(files) = self.filter.as_mut() else {
+            return Ok(());
+        };
+        let row = match e {
+            Event::Measurement(i) => return files.innovations.push(&i),
+            Event::Refused(r) => (
+                r.t,
+                format!(
+                    "{},{},chi-square gate,{},{}\n",
+                    r.t, r.kind, r.rejection.nis, r.rejection.threshold
+                ),
+            ),
+            Event::Skipped(k) => {
+                let why = match k.reason {
+                    SkipReason::BeforeImu => "before the IMU data",
+                    SkipReason::AfterImu => "after the IMU data",
+                };
+                (k.t, format!("{},{},{why},,\n", k.t, k.kind))
+            }
+            Event::GateReset { t } => (
+                t,
+                format!(
+                    "{t},gnss_position,accepted without the gate after consecutive refusals (filter reset),,\n"
+                ),
+            ),
+            Event::Late {
+                t,
+                kind,
+                integrated_to,
+            } => (
+                t,
+                format!(
+                    "{t},{kind},arrived after its sample was integrated (at {integrated_to}),,\n"
+                ),
+            ),
+            Event::Ignored { t, kind, reason } => (t, format!("{t},{kind},{reason},,\n")),
+            Event::Handover(_) => return Ok(()),
+        };
+        files.refused.push(row);
+        Ok(())
+    }
+
+    /// Writes the session's epochs and events so far.
+    pub fn take<E: EarthModel>(&mut self, session: &mut Session<E>) -> Result<()> {
+        for e in session.epochs() {
+            self.epoch(&e)?;
+        }
+        for e in session.events() {
+            self.event(e)?;
+        }
+        Ok(())
+    }
+}
+
+/// What a driven run leaves: the session's end and, if the input failed, the error
+/// (everything before it was written).
+pub struct Driven {
+    /// The session's end.
+    pub finished: Finished,
+    /// The read error that stopped the run, with what was written.
+    pub failure: Option<anyhow::Error>,
+    /// Epochs written.
+    pub epochs: u64,
+    /// The filter's files, still open (for `rejected.csv` and the report).
+    pub filter: Option<FilterFiles>,
+}
+
+/// Pushes `samples` into `session`, writing what comes out to `out`; `on_sample` is
+/// called every 65,536 samples with their count. On a read error the session ends
+/// there, its last state is written (if it was not an output epoch) and the error is
+/// returned in [`Driven::failure`] with the count and the time reached. `None` when
+/// the input held no sample at all.
+pub fn drive<E: EarthModel, I>(
+    mut session: Session<E>,
+    samples: I,
+    mut out: Outputs,
+    dir: &Path,
+    mut on_sample: impl FnMut(u64),
+) -> Result<Option<Driven>>
+where
+    I: Iterator<Item = Result<ImuSample, InputError>>,
+{
+    let mut n = 0u64;
+    let mut failure: Option<anyhow::Error> = None;
+    for s in samples {
+        let pushed = s
+            .map_err(anyhow::Error::new)
+            .and_then(|s| session.push_imu(s).map_err(anyhow::Error::new));
+        if let Err(e) = pushed {
+            failure = Some(e);
+            break;
+        }
+        out.take(&mut session)?;
+        n += 1;
+        if n.is_multiple_of(65_536) {
+            on_sample(n);
+        }
+    }
+    session.end_of_input();
+    out.take(&mut session)?;
+    if n == 0 {
+        // Nothing was pushed: the session has no state to report.
+        return failure.map_or(Ok(None), Err);
+    }
+    if failure.is_some()
+        && let Some(e) = session.epoch_now()
+        && e.state.t != out.last_written
+    {
+        out.epoch(&e)?;
+    }
+    let finished = session.finish()?;
+    let epochs = out.nav.finish()?;
+    let failure = failure.map(|e| {
+        e.context(format!(
+            "stopped after {} samples; {epochs} epochs up to t = {} were written to {}",
+            finished.summary.samples,
+            finished.summary.t_last,
+            dir.display()
+        ))
+    });
+    Ok(Some(Driven {
+        finished,
+        failure,
+        epochs,
+        filter: out.filter,
+    }))
+}
+
+/// The smoothed trajectory: `nav.txt`, `nav.csv`, `std.txt`, `imu_err.txt` in `dir`.
+pub fn write_smoothed<E: EarthModel>(
+    earth: &E,
+    dir: &Path,
+    week: u32,
+    smoothed: &[Smoothed],
+) -> Result<()> {
+    let mut nav = NavWriter::create_extended(dir, week, earth)?;
+    let mut std = Table::create(dir, "std.txt")?;
+    let mut err = Table::create(dir, "imu_err.txt")?;
+    for s in smoothed {
+        nav.write_epoch(&NavEpoch {
+            state: s.state,
+            r_e: earth.geodetic_to_ecef(&s.state.pos),
+            wander_azimuth: 0.0,
+        })?;
+        let mut row: Vec<f64> = s.std[0].iter().chain(s.std[1].iter()).copied().collect();
+        row.extend(s.std[2].iter().map(|x| x.to_degrees()));
+        std.row(s.state.t, &row)?;
+        err.row(s.state.t, &imu_err_row(&s.estimates))?;
+    }
+    nav.finish()?;
+    std.finish()?;
+    err.finish()
+}

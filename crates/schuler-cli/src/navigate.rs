@@ -1,0 +1,173 @@
+//! The run shared by `schuler nav` and its KF-GINS mode: a library [`Session`]
+//! configured from the settings (and the aiding, if any), fed from the IMU reader,
+//! its output written by [`crate::drive`]. With aiding the run also writes
+//! `rejected.csv`, the smoothed trajectory on request and the consistency report.
+
+use crate::aided::Aiding;
+use crate::aided::report::{ReportData, RunFacts};
+use crate::drive::{Driven, FilterFiles, Outputs, drive, write_smoothed};
+use crate::formats::{ImuReadOptions, InputError};
+use crate::options::EarthChoice;
+use crate::output::NavWriter;
+use anyhow::{Result, bail};
+use nalgebra::Vector3;
+use schuler::earth::{EarthModel, Geodetic};
+use schuler::filter::{GnssFix, Layout};
+use schuler::imu::ImuSample;
+use schuler::nav::NavState;
+use schuler::rotation::Euler;
+use schuler::session::{Aid, MechanizationConfig, Session, SessionConfig, Start, Summary};
+use std::path::PathBuf;
+
+/// Everything a run needs besides its aiding, validated.
+#[derive(Debug, Clone)]
+pub struct NavSettings {
+    /// IMU log.
+    pub imu: PathBuf,
+    /// Reader options.
+    pub read: ImuReadOptions,
+    /// Initial position (at the first processed sample's time).
+    pub init_pos: Geodetic,
+    /// Initial NED velocity [m/s].
+    pub init_vel: Vector3<f64>,
+    /// Initial attitude.
+    pub init_att: Euler,
+    /// Output rate [Hz], `None`: every sample.
+    pub output_rate: Option<f64>,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Earth model.
+    pub earth: EarthChoice,
+    /// GPS week for nav.txt.
+    pub week: u32,
+    /// The mechanization and its hand-over latitudes.
+    pub mechanization: MechanizationConfig,
+}
+
+impl NavSettings {
+    /// The start the settings give (no sensor error known).
+    pub fn start(&self) -> Start {
+        Start::at(NavState::new(
+            0.0,
+            self.init_pos,
+            self.init_vel,
+            self.init_att,
+        ))
+    }
+
+    /// The session's configuration, with the filter of `aiding` if any.
+    pub fn session_config(&self, aiding: Option<&Aiding>) -> SessionConfig {
+        SessionConfig {
+            mechanization: self.mechanization,
+            output_rate: self.output_rate,
+            filter: aiding.map(|a| a.filter),
+            ..SessionConfig::default()
+        }
+    }
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// The session's summary.
+    pub nav: Summary,
+    /// Epochs written.
+    pub epochs: u64,
+    /// The consistency summary to print (aided runs).
+    pub report_text: String,
+}
+
+/// Navigate `samples` (the first carries `start`) on `earth` with the settings and,
+/// if given, the aiding; write everything into `settings.out`. On a read error all
+/// that was computed is written before the error is returned.
+pub fn navigate<E: EarthModel, I>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+    start: Start,
+    samples: I,
+    on_sample: impl FnMut(u64),
+) -> Result<RunSummary>
+where
+    I: Iterator<Item = Result<ImuSample, InputError>>,
+{
+    let out = &settings.out;
+    let mut session = Session::new(earth, settings.session_config(aiding), start)?;
+    let nav_name = aiding.map_or("nav.txt", |a| a.names.nav);
+    let writer = NavWriter::create_named(out, nav_name, settings.week, &earth)?;
+    let files = match aiding {
+        Some(a) => {
+            session = session.with_truth(a.report.truth_rows().to_vec());
+            for aid in aids(a) {
+                session.push(aid)?;
+            }
+            Some(FilterFiles::create(out, a.names.std, a.names.imu_err)?)
+        }
+        None => None,
+    };
+    let Some(driven) = drive(
+        session,
+        samples,
+        Outputs::new(writer, files),
+        out,
+        on_sample,
+    )?
+    else {
+        bail!(
+            "{}: no IMU sample in the requested time window",
+            settings.imu.display()
+        );
+    };
+    let Driven {
+        finished,
+        failure,
+        epochs,
+        filter,
+    } = driven;
+    let mut report_text = String::new();
+    if let (Some(a), Some(files)) = (aiding, filter) {
+        let log = files.finish(out)?;
+        if let Some(smoothed) = &finished.smoothed {
+            write_smoothed(&earth, &out.join("smoothed"), settings.week, smoothed)?;
+        }
+        if let Some(e) = failure {
+            return Err(e);
+        }
+        let s = &finished.summary;
+        report_text = crate::aided::report::write(
+            out,
+            a.report.html,
+            &ReportData {
+                facts: RunFacts {
+                    imu: &settings.imu,
+                    nav_file: &out.join(a.names.nav),
+                    mechanization: s.first_mechanization,
+                    layout: s.layout.unwrap_or_else(Layout::core),
+                    samples: s.samples,
+                    t_first: s.t_first,
+                    t_last: s.t_last,
+                    counts: s.counts,
+                    gate_resets: s.gate_resets as usize,
+                    fixes: &a.fixes,
+                },
+                innovations: &log.rows,
+                samples: &finished.snapshots,
+                settings: &a.report,
+            },
+        )?;
+    } else if let Some(e) = failure {
+        return Err(e);
+    }
+    Ok(RunSummary {
+        nav: finished.summary,
+        epochs,
+        report_text,
+    })
+}
+
+/// Every aid of a run, as pushed: GNSS fixes, barometer readings, vehicle readings.
+fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {
+    let fixes = a.fixes.iter().map(|f: &GnssFix| Aid::Gnss(*f));
+    let baro = a.baro.iter().map(|&(t, h)| Aid::Baro { t, h });
+    fixes.chain(baro).chain(a.vehicle.aids())
+}

@@ -1,0 +1,174 @@
+//! Aiding measurements as a front end pushes them, and the per-kind queues that hold
+//! them in time order until the samples they fall in are integrated.
+//!
+//! An aid is *late* when it arrives after the sample it belongs to was integrated: a
+//! GNSS fix earlier than the integrated time (it is applied at its own time, inside a
+//! sample), a reading applied at the nearest sample end (barometer, odometer,
+//! heading) within half a sample of the integrated time or earlier, a rest interval
+//! that began before it. Late aids are reported, never applied and never silently
+//! dropped; [`super::SessionConfig::reorder_window`] sets how late an aid may be.
+
+use crate::filter::measurement::Kind;
+use crate::filter::{GnssFix, HeadingReading};
+use std::collections::VecDeque;
+
+/// One aiding measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Aid {
+    /// A GNSS position (and optionally velocity) fix with its standard deviations.
+    Gnss(GnssFix),
+    /// A barometric height [m] at time `t` [s].
+    Baro {
+        /// Time [s].
+        t: f64,
+        /// Height [m].
+        h: f64,
+    },
+    /// An odometer speed [m/s] at time `t` [s].
+    Odometer {
+        /// Time [s].
+        t: f64,
+        /// Speed of the vehicle's constraint point [m/s].
+        speed: f64,
+    },
+    /// A dual-antenna heading.
+    Heading(HeadingReading),
+    /// The vehicle at rest from `t0` to `t1` [s].
+    Rest {
+        /// Start [s].
+        t0: f64,
+        /// End [s].
+        t1: f64,
+    },
+}
+
+impl Aid {
+    /// The time the aid speaks of (a rest's start).
+    pub fn t(&self) -> f64 {
+        match self {
+            Aid::Gnss(f) => f.t,
+            Aid::Baro { t, .. } | Aid::Odometer { t, .. } => *t,
+            Aid::Heading(h) => h.t,
+            Aid::Rest { t0, .. } => *t0,
+        }
+    }
+
+    /// The measurement kind it becomes.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Aid::Gnss(_) => Kind::GnssPosition,
+            Aid::Baro { .. } => Kind::BaroHeight,
+            Aid::Odometer { .. } => Kind::Odometer,
+            Aid::Heading(_) => Kind::Heading,
+            Aid::Rest { .. } => Kind::ZeroVelocity,
+        }
+    }
+
+    /// Whether every number it carries is finite (and a rest ends after it starts).
+    pub fn is_finite(&self) -> bool {
+        match self {
+            Aid::Gnss(f) => {
+                f.t.is_finite()
+                    && f.pos.lat.is_finite()
+                    && f.pos.lon.is_finite()
+                    && f.pos.h.is_finite()
+                    && f.pos_std.iter().all(|x| x.is_finite() && *x > 0.0)
+                    && f.vel.is_none_or(|(v, s)| {
+                        v.iter().all(|x| x.is_finite())
+                            && s.iter().all(|x| x.is_finite() && *x > 0.0)
+                    })
+            }
+            Aid::Baro { t, h } => t.is_finite() && h.is_finite(),
+            Aid::Odometer { t, speed } => t.is_finite() && speed.is_finite(),
+            Aid::Heading(r) => {
+                r.t.is_finite()
+                    && r.heading.is_finite()
+                    && r.heading_std.is_finite()
+                    && r.heading_std > 0.0
+                    && r.pitch
+                        .is_none_or(|(p, s)| p.is_finite() && s.is_finite() && s > 0.0)
+            }
+            Aid::Rest { t0, t1 } => t0.is_finite() && t1.is_finite() && t1 >= t0,
+        }
+    }
+}
+
+/// Insert `x` into `q` keeping it sorted by `t` (stable: after equal times). Aids
+/// arrive nearly in order, so the search runs from the back.
+pub(crate) fn insert_sorted<T>(q: &mut VecDeque<T>, x: T, t: impl Fn(&T) -> f64) {
+    let tx = t(&x);
+    let mut i = q.len();
+    while i > 0 && t(&q[i - 1]) > tx {
+        i -= 1;
+    }
+    q.insert(i, x);
+}
+
+/// The aids waiting for their samples, one queue per kind, each in time order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct AidQueues {
+    pub gnss: VecDeque<GnssFix>,
+    pub baro: VecDeque<(f64, f64)>,
+    pub odometer: VecDeque<(f64, f64)>,
+    pub heading: VecDeque<HeadingReading>,
+    pub rest: VecDeque<(f64, f64)>,
+}
+
+impl AidQueues {
+    /// Queue `aid` (checked and accepted by the caller).
+    pub fn push(&mut self, aid: Aid) {
+        match aid {
+            Aid::Gnss(f) => insert_sorted(&mut self.gnss, f, |f| f.t),
+            Aid::Baro { t, h } => insert_sorted(&mut self.baro, (t, h), |r| r.0),
+            Aid::Odometer { t, speed } => insert_sorted(&mut self.odometer, (t, speed), |r| r.0),
+            Aid::Heading(r) => insert_sorted(&mut self.heading, r, |r| r.t),
+            Aid::Rest { t0, t1 } => insert_sorted(&mut self.rest, (t0, t1), |r| r.0),
+        }
+    }
+}
+
+/// Whether `aid` comes too late for a session that has integrated up to `t_done`
+/// with a last sample interval `dt` (module doc).
+pub(crate) fn is_late(aid: &Aid, t_done: f64, dt: f64) -> bool {
+    match aid {
+        Aid::Gnss(f) => f.t < t_done - 1e-3 * dt,
+        Aid::Baro { t, .. } | Aid::Odometer { t, .. } => *t <= t_done + 0.5 * dt,
+        Aid::Heading(r) => r.t <= t_done + 0.5 * dt,
+        Aid::Rest { t0, .. } => *t0 < t_done,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn insertion_keeps_time_order_and_arrival_order_among_equal_times() {
+        let mut q = VecDeque::new();
+        for (t, tag) in [(1.0, 'a'), (3.0, 'b'), (2.0, 'c'), (3.0, 'd'), (0.5, 'e')] {
+            insert_sorted(&mut q, (t, tag), |x| x.0);
+        }
+        let tags: String = q.iter().map(|x| x.1).collect();
+        assert_eq!(tags, "eacbd");
+    }
+
+    #[test]
+    fn lateness_follows_each_kind_application_rule() {
+        let dt = 0.01;
+        // A fix inside the integrated span is late; one at its end is applied there.
+        let fix = |t| {
+            Aid::Gnss(GnssFix {
+                t,
+                pos: crate::earth::Geodetic::new(0.0, 0.0, 0.0),
+                pos_std: nalgebra::Vector3::repeat(1.0),
+                vel: None,
+            })
+        };
+        assert!(is_late(&fix(9.99), 10.0, dt));
+        assert!(!is_late(&fix(10.0), 10.0, dt));
+        // A reading within half a sample of the last end belonged to that sample.
+        assert!(is_late(&Aid::Baro { t: 10.004, h: 0.0 }, 10.0, dt));
+        assert!(!is_late(&Aid::Baro { t: 10.006, h: 0.0 }, 10.0, dt));
+        assert!(is_late(&Aid::Rest { t0: 9.0, t1: 11.0 }, 10.0, dt));
+    }
+}

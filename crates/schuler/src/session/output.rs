@@ -1,0 +1,224 @@
+//! What a session gives back as it goes: output epochs at the chosen cadence, events
+//! (every measurement tested, refused, skipped, late or ignored; hand-overs), and the
+//! filter's snapshots for consistency reports.
+
+use super::config::MechanizationKind;
+use crate::analysis::consistency::normalized_squared;
+use crate::analysis::errors::{NavRecord, TruthAt, TruthCursor, errors_between};
+use crate::earth::EarthModel;
+use crate::filter::integration::{Innovation, Rejected, Skipped};
+use crate::filter::kalman::std3;
+use crate::filter::measurement::Kind;
+use crate::filter::{Integrator, Layout, SensorEstimates};
+use crate::nav::{ErrorFrame, NavState};
+use nalgebra::{Matrix3, Vector3};
+
+/// One output epoch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Epoch {
+    /// The navigation state (NED; at a pole relative to the pole longitude's meridian).
+    pub state: NavState,
+    /// ECEF position [m] (defined everywhere, poles included).
+    pub r_e: Vector3<f64>,
+    /// Wander azimuth [rad]: the navigation frame's x axis east of north (0 on NED).
+    pub wander_azimuth: f64,
+    /// The mechanization that produced it.
+    pub mechanization: MechanizationKind,
+    /// The filter's view, when a filter runs.
+    pub filter: Option<FilterEpoch>,
+}
+
+/// The filter's uncertainty and sensor-error estimates at an output epoch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilterEpoch {
+    /// Standard deviations of position, velocity (NED, m and m/s) and attitude
+    /// (about north, east, down, rad).
+    pub nav_std: [Vector3<f64>; 3],
+    /// Estimated sensor errors.
+    pub estimates: SensorEstimates,
+    /// Standard deviations of gyro bias [rad/s], accelerometer bias [m/s^2], gyro and
+    /// accelerometer scale factors (zero where not estimated).
+    pub sensor_std: [Vector3<f64>; 4],
+}
+
+impl FilterEpoch {
+    /// The filter's view now.
+    pub fn of<M: ErrorFrame, E: EarthModel>(integ: &Integrator<M, E>) -> Self {
+        let p = integ.covariance();
+        let l = integ.layout();
+        let std = |o: Option<usize>| o.map_or(Vector3::zeros(), |o| std3(p, o));
+        Self {
+            nav_std: integ.nav_std(),
+            estimates: integ.estimates(),
+            sensor_std: [
+                std(Some(Layout::GYRO_BIAS)),
+                std(Some(Layout::ACCEL_BIAS)),
+                std(l.gyro_scale),
+                std(l.accel_scale),
+            ],
+        }
+    }
+}
+
+/// A hand-over between mechanizations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Handover {
+    /// Time [s] of the state handed over.
+    pub t: f64,
+    /// Latitude [rad] there.
+    pub lat: f64,
+    /// The mechanization taking over.
+    pub to: MechanizationKind,
+}
+
+/// Something the session did that its caller may want to know, in time order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// A measurement the filter tested, accepted or refused, with its innovation and
+    /// normalized innovation squared.
+    Measurement(Innovation),
+    /// A measurement the gate refused, with the test's numbers.
+    Refused(Rejected),
+    /// A GNSS position accepted without the gate after consecutive refusals.
+    GateReset {
+        /// Time [s].
+        t: f64,
+    },
+    /// A measurement outside the IMU data.
+    Skipped(Skipped),
+    /// An aid that arrived after the sample it belongs to was integrated.
+    Late {
+        /// The aid's time [s].
+        t: f64,
+        /// What it was.
+        kind: Kind,
+        /// How far the session had integrated when it arrived [s].
+        integrated_to: f64,
+    },
+    /// An aid the configuration has no use for (e.g. GNSS without a filter).
+    Ignored {
+        /// The aid's time [s].
+        t: f64,
+        /// What it was.
+        kind: Kind,
+        /// Why.
+        reason: &'static str,
+    },
+    /// A hand-over between mechanizations.
+    Handover(Handover),
+}
+
+/// Decides which epochs to emit: every one, or the first epoch at or after each
+/// multiple of `1/rate` (a thousandth of a sample interval of tolerance absorbs the
+/// decimal time tags of logs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decimator {
+    rate: Option<f64>,
+    last_slot: f64,
+}
+
+impl Decimator {
+    /// Every epoch (`None`) or `rate` [Hz].
+    pub fn new(rate: Option<f64>) -> Self {
+        Self {
+            rate,
+            last_slot: f64::NEG_INFINITY,
+        }
+    }
+
+    /// Whether the sample ending at `t` after `dt` is an output epoch.
+    #[inline]
+    pub fn take(&mut self, t: f64, dt: f64) -> bool {
+        match self.rate {
+            None => true,
+            Some(r) => {
+                let slot = ((t + 1e-3 * dt) * r).floor();
+                let take = slot > self.last_slot;
+                if take {
+                    self.last_slot = slot;
+                }
+                take
+            }
+        }
+    }
+}
+
+/// The filter's sensor errors, covariance and, against a truth, its normalized
+/// estimation errors squared (NEES) at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Snapshot {
+    /// Time [s].
+    pub t: f64,
+    /// Estimated sensor errors.
+    pub estimates: SensorEstimates,
+    /// Standard deviations of gyro bias [rad/s], accelerometer bias [m/s^2], gyro and
+    /// accelerometer scale factors (zero where not estimated).
+    pub sensor_std: [Vector3<f64>; 4],
+    /// Standard deviation of the barometer bias [m], when estimated.
+    pub baro_std: Option<f64>,
+    /// NEES of position, velocity and attitude (3 dof each): `None` without a truth
+    /// at this time; an entry `None` where the covariance block is not positive
+    /// definite.
+    pub nees: Option<[Option<f64>; 3]>,
+}
+
+/// Takes a [`Snapshot`] at a cadence, with NEES against a truth when it has one.
+#[derive(Debug, Clone)]
+pub(crate) struct SnapshotTaker {
+    truth: Vec<NavRecord>,
+    cursor: TruthCursor,
+    cadence: Decimator,
+    pub taken: Vec<Snapshot>,
+}
+
+impl SnapshotTaker {
+    pub fn new(rate: f64, truth: Vec<NavRecord>) -> Self {
+        Self {
+            truth,
+            cursor: TruthCursor::default(),
+            cadence: Decimator::new(Some(rate)),
+            taken: Vec::new(),
+        }
+    }
+
+    /// After a sample ending at `t` after `dt`: a snapshot at the first epoch of each
+    /// period.
+    pub fn after_sample<M: ErrorFrame, E: EarthModel>(
+        &mut self,
+        earth: &E,
+        integ: &Integrator<M, E>,
+        t: f64,
+        dt: f64,
+    ) {
+        if !self.cadence.take(t, dt) {
+            return;
+        }
+        let p = integ.covariance();
+        let l = integ.layout();
+        let state = integ.state();
+        let nees = if self.truth.is_empty() {
+            None
+        } else {
+            match self.cursor.at(&self.truth, state.t) {
+                TruthAt::Exact(truth) | TruthAt::Interpolated(truth, _) => {
+                    let e = errors_between(earth, &state, &(&truth).into());
+                    let [pp, pv, pa]: [Matrix3<f64>; 3] = integ.nav_covariance();
+                    Some([
+                        normalized_squared(&e.pos_n, &pp),
+                        normalized_squared(&e.v_n, &pv),
+                        normalized_squared(&e.psi, &pa),
+                    ])
+                }
+                TruthAt::Before | TruthAt::After => None,
+            }
+        };
+        let f = FilterEpoch::of(integ);
+        self.taken.push(Snapshot {
+            t: state.t,
+            estimates: f.estimates,
+            sensor_std: f.sensor_std,
+            baro_std: l.baro_bias.map(|b| p[(b, b)].max(0.0).sqrt()),
+            nees,
+        });
+    }
+}
