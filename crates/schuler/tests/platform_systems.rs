@@ -519,7 +519,7 @@ fn gyro_scale_factor_costs_the_sins_a_full_turn_and_the_platform_nothing() {
         duration: 60.0,
         angle: TAU,
     };
-    let mut model = schuler::sim::imu_model::ImuModel::default();
+    let mut model = schuler::imu::model::ImuModel::default();
     model.gyro.scale = Vector3::new(1e-5, 1e-5, 1e-5);
     let mut cfg = config(vec![
         SystemKind::Sins,
