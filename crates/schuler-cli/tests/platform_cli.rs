@@ -101,7 +101,7 @@ fn writes_every_file_and_the_leveled_systems_stay_at_zero() {
         if name == "gyro-free" {
             // 1e-9 m/s^2 on the cube's +x accelerometer (rho = 0.5 m): angular
             // acceleration d/(2 sqrt2 rho) = 7.07e-10 rad/s^2 about the (level) body y
-            // axis (and as much about down); the growth law of nav::platform::gyro_free,
+            // axis (and as much about down); the growth law of lab::platform::gyro_free,
             // (g eps/w0^2)(t^2/2 - (1 - cos w0 t)/w0^2), gives 561 m at 20 min.
             let (g, a, t) = (9.81f64, 6.371e6f64, 1200.0f64);
             let w0 = (g / a).sqrt();

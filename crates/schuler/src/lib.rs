@@ -11,6 +11,7 @@ pub mod channel;
 pub mod earth;
 pub mod filter;
 pub mod imu;
+pub mod lab;
 pub mod nav;
 pub mod rotation;
 pub mod session;

@@ -15,10 +15,11 @@ use schuler::analysis::errors::errors_between;
 use schuler::earth::{EarthModel, Geodetic, Wgs84};
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
+use schuler::imu::model::{ImuModel, VibrationLine};
 use schuler::nav::{LocalLevel, Mechanization, NavState};
 use schuler::rotation::{Euler, rotation_vector_from_quaternion};
 use schuler::sim::analytic::{self, Trajectory};
-use schuler::sim::imu_model::{ImuModel, ImuSimulator, VibrationLine};
+use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::jet::{Jet, JetMat3, JetVec3};
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
 

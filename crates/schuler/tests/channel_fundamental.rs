@@ -68,7 +68,7 @@ fn fundamental_matrix_16_is_expm_of_15() {
 fn matrix<const N: usize>(seed: u64, scale: f64) -> SMatrix<f64, N, N> {
     let mut s = seed;
     SMatrix::from_fn(|_, _| {
-        let z = schuler::sim::random::splitmix64(&mut s);
+        let z = schuler::imu::random::splitmix64(&mut s);
         ((z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * scale
     })
 }

@@ -148,7 +148,7 @@ fn data() -> &'static Data {
     })
 }
 
-fn tactical() -> schuler::sim::imu_model::ImuModel {
+fn tactical() -> schuler::imu::model::ImuModel {
     let spec: ScenarioSpec = toml::from_str(SCENARIO).expect("scenario");
     spec.imu.model().expect("imu")
 }

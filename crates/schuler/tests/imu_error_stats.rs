@@ -5,7 +5,8 @@
 use nalgebra::Vector3;
 use schuler::analysis::allan::allan_deviation;
 use schuler::imu::ImuSample;
-use schuler::sim::imu_model::{ImuModel, ImuSimulator};
+use schuler::imu::model::ImuModel;
+use schuler::sim::imu_model::ImuSimulator;
 use schuler::units::{DEG, DEG_PER_H};
 
 /// Errors alone: the gyro x increments of a stationary zero-input IMU.

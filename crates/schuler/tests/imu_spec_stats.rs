@@ -7,7 +7,8 @@
 use nalgebra::Vector3;
 use schuler::analysis::allan::allan_deviation;
 use schuler::imu::ImuSample;
-use schuler::sim::imu_model::{ImuModel, ImuSimulator};
+use schuler::imu::model::ImuModel;
+use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::sensor_spec::ImuSpec;
 use schuler::units::{DEG_PER_H_PER_G, DEG_PER_H_PER_SQRT_H, UG};
 

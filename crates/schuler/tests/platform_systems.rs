@@ -1,4 +1,4 @@
-//! Lecture 22's systems on simulated truth (`schuler::nav::platform`): perfect
+//! Lecture 22's systems on simulated truth (`schuler::lab::platform`): perfect
 //! instruments, leveling with biased accelerometers through a turn, the Schuler
 //! period, the platform's vertical rate in each azimuth mechanization, and the
 //! gyro-free INS's error growth. Truth comes from the trajectories' exact kinematics
@@ -6,11 +6,11 @@
 
 use nalgebra::{Vector3, Vector6};
 use schuler::earth::{EarthModel, Geodetic, Sphere, Wgs84};
-use schuler::nav::NavState;
-use schuler::nav::platform::compare::{CompareConfig, Comparison, SystemKind, compare};
-use schuler::nav::platform::{
+use schuler::lab::platform::compare::{CompareConfig, Comparison, SystemKind, compare};
+use schuler::lab::platform::{
     AccelerometerArray, Azimuth, InstrumentErrors, PlatformIns, TruthPoint, VerticalChannel,
 };
+use schuler::nav::NavState;
 use schuler::rotation::Euler;
 use schuler::sim::analytic::{Maneuvering, Stationary, Trajectory};
 use schuler::sim::jet::{Jet, JetMat3, JetVec3};
@@ -32,7 +32,7 @@ fn config(systems: Vec<SystemKind>) -> CompareConfig {
     }
 }
 
-fn max_of(c: &Comparison, s: usize, f: impl Fn(&schuler::nav::platform::NavError) -> f64) -> f64 {
+fn max_of(c: &Comparison, s: usize, f: impl Fn(&schuler::lab::platform::NavError) -> f64) -> f64 {
     c.errors[s].iter().map(f).fold(0.0, f64::max)
 }
 
@@ -462,8 +462,8 @@ fn orthodromic_platform_stays_on_the_great_circle() {
         d0: c_ne * Vector3::new(heading.cos(), heading.sin(), 0.0),
         speed: 250.0,
     };
-    use schuler::nav::platform::TruthDriven;
-    let start = schuler::nav::platform::truth_at(&earth, &traj, 0.0);
+    use schuler::lab::platform::TruthDriven;
+    let start = schuler::lab::platform::truth_at(&earth, &traj, 0.0);
     let new = |az| {
         PlatformIns::new(
             earth,
@@ -481,8 +481,8 @@ fn orthodromic_platform_stays_on_the_great_circle() {
     let w_sin = |p: &TruthPoint| earth.rotation_rate * p.state.pos.lat.sin();
     let mut earth_part = 0.0;
     for k in 1..=3600 {
-        let m = schuler::nav::platform::truth_at(&earth, &traj, (k as f64 - 0.5) * dt);
-        let c = schuler::nav::platform::truth_at(&earth, &traj, k as f64 * dt);
+        let m = schuler::lab::platform::truth_at(&earth, &traj, (k as f64 - 0.5) * dt);
+        let c = schuler::lab::platform::truth_at(&earth, &traj, k as f64 * dt);
         orth.step(&a, &m, &c);
         free.step(&a, &m, &c);
         // Simpson on the step.
@@ -519,7 +519,7 @@ fn gyro_scale_factor_costs_the_sins_a_full_turn_and_the_platform_nothing() {
         duration: 60.0,
         angle: TAU,
     };
-    let mut model = schuler::sim::imu_model::ImuModel::default();
+    let mut model = schuler::imu::model::ImuModel::default();
     model.gyro.scale = Vector3::new(1e-5, 1e-5, 1e-5);
     let mut cfg = config(vec![
         SystemKind::Sins,

@@ -147,7 +147,7 @@ fn straight() -> &'static Data {
     DATA.get_or_init(|| simulated(STRAIGHT))
 }
 
-fn mems() -> schuler::sim::imu_model::ImuModel {
+fn mems() -> schuler::imu::model::ImuModel {
     let spec: ScenarioSpec = toml::from_str(DRIVE).expect("scenario");
     spec.imu.model().expect("imu")
 }
@@ -267,7 +267,7 @@ fn run(d: &Data, seed: u64, gnss: &[GnssFix], aids: Aids) -> Run {
 /// turn-on bias at the end.
 fn run_with(
     d: &Data,
-    model: schuler::sim::imu_model::ImuModel,
+    model: schuler::imu::model::ImuModel,
     seed: u64,
     gnss: &[GnssFix],
     aids: Aids,

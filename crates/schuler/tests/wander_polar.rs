@@ -421,8 +421,8 @@ fn stationary_at_the_pole_stays_put() {
 fn gnss_aided_flight_over_the_pole_keeps_mid_latitude_accuracy() {
     use schuler::filter::ImuNoise;
     use schuler::filter::integration::{GnssFix, IntegrationConfig, Integrator};
+    use schuler::imu::random::Noise;
     use schuler::sim::imu_model::ImuSimulator;
-    use schuler::sim::random::Noise;
     use schuler::sim::sensor_spec::{ImuSpec, Preset};
     let earth = Wgs84;
     let traj = OverThePole::flight(&earth, 0.0);

@@ -1,7 +1,7 @@
 //! `schuler platform --config FILE --out DIR`: lecture 22's systems on one trajectory
 //! with the same instrument error magnitudes — the strapdown INS, the platform INS in
 //! its geographic, orthodromic and free-azimuth mechanizations, the analytic INS and
-//! the gyro-free six-accelerometer INS ([`schuler::nav::platform`]).
+//! the gyro-free six-accelerometer INS ([`schuler::lab::platform`]).
 //!
 //! The config is a scenario's `[start]` and `[[motion]]` (as for `schuler simulate`)
 //! plus the run's settings, `[errors]`, `[gyro_free]` and optionally a scenario's
@@ -18,8 +18,8 @@ use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result, bail};
 use nalgebra::{Vector3, Vector6};
 use schuler::earth::{EarthModel, Sphere, Wgs84};
-use schuler::nav::platform::compare::{CompareConfig, Comparison, NavError, SystemKind, compare};
-use schuler::nav::platform::{AccelerometerArray, InstrumentErrors, VerticalChannel};
+use schuler::lab::platform::compare::{CompareConfig, Comparison, NavError, SystemKind, compare};
+use schuler::lab::platform::{AccelerometerArray, InstrumentErrors, VerticalChannel};
 use schuler::sim::run::EarthSpec;
 use schuler::sim::scenario::{MotionSpec, Quantity, SegmentSpec, StartSpec};
 use schuler::sim::sensor_spec::ImuSpec;

@@ -153,7 +153,7 @@ impl RestDetector {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::random::Noise;
+    use crate::imu::random::Noise;
 
     fn noise() -> ImuNoise {
         // Consumer-MEMS-like: 0.5 deg/sqrt(h), 0.2 m/s/sqrt(h), 10 deg/h, 5 mg.

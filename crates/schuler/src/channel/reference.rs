@@ -5,7 +5,7 @@
 use super::ChannelError;
 use super::error::finite;
 use super::ode::Grid;
-use crate::sim::random::Noise as Draws;
+use crate::imu::random::Noise as Draws;
 
 /// One injected outlier: the sample nearest `t` \[s\] is offset by `size` \[m\].
 #[derive(Debug, Clone, Copy, PartialEq)]

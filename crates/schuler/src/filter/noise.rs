@@ -8,7 +8,7 @@
 //! `ḃ = −b/τ + w` with the same density (finite `τ`, as KF-GINS models them). The prior
 //! is the total of constant, turn-on and instability variances.
 
-use crate::sim::imu_model::{ImuModel, TriadModel};
+use crate::imu::model::{ImuModel, TriadModel};
 use nalgebra::Vector3;
 
 /// Noise and bias statistics per axis (SI).

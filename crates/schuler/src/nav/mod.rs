@@ -15,7 +15,6 @@
 pub mod baro_loop;
 pub mod frame;
 pub mod local_level;
-pub mod platform;
 pub mod state;
 pub mod strapdown;
 pub mod wander;

@@ -6,7 +6,6 @@ pub mod gnss_ins_sim;
 pub mod imu_model;
 pub mod jet;
 pub mod motion;
-pub mod random;
 pub mod receivers;
 pub mod run;
 pub mod scenario;

@@ -15,8 +15,8 @@
 //! Barometer: true height plus bias, a linear drift, white noise; no reading inside
 //! dropouts; outliers add a jump at given epochs.
 
-use super::random::Noise;
 use crate::earth::{EarthModel, Geodetic, c_ned_to_ned};
+use crate::imu::random::Noise;
 use crate::nav::NavState;
 use nalgebra::Vector3;
 

@@ -1,5 +1,5 @@
 //! Sensor descriptions in engineering units, IMU grade presets, and their resolution
-//! into the SI models of [`super::imu_model`] and [`super::receivers`].
+//! into the SI models of [`crate::imu::model`] and [`super::receivers`].
 //!
 //! Presets (typical one-sigma values of the three classic grades, after Groves,
 //! *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd
@@ -19,9 +19,9 @@
 //! misalignment, asymmetry, quantization, and the gyro g-sensitivity
 //! (`g_sensitivity = "2 deg/h/g"` in `[imu]`).
 
-use super::imu_model::{ImuModel, TriadModel, VibrationLine};
 use super::receivers::{BaroModel, GnssModel, Interval, Outlier};
 use super::scenario::{Quantity, ScenarioError};
+use crate::imu::model::{ImuModel, TriadModel, VibrationLine};
 use crate::units::Dimension;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};

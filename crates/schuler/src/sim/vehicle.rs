@@ -3,8 +3,8 @@
 //! true heading and pitch plus white noise), and the rest intervals of a trajectory
 //! (where its speed is zero), for zero-velocity updates.
 
-use super::random::Noise;
 use crate::filter::vehicle::{Baseline, HeadingReading, heading_pitch};
+use crate::imu::random::Noise;
 use crate::nav::NavState;
 
 /// Stream ids (after the IMU's 1, GNSS's 2 and the barometer's 3).

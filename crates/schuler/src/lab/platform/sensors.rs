@@ -1,6 +1,6 @@
 //! The instruments of a truth-driven system: constant biases and drifts
 //! ([`InstrumentErrors`]) plus, optionally, the simulator's full IMU error model
-//! ([`crate::sim::imu_model`]: turn-on bias, bias instability, random walks, white
+//! ([`crate::imu::model`]: turn-on bias, bias instability, random walks, white
 //! noise, scale factor, misalignment, quantization...), applied to what a platform's
 //! own sensors see.
 //!
@@ -13,7 +13,8 @@
 
 use super::InstrumentErrors;
 use crate::imu::ImuSample;
-use crate::sim::imu_model::{ImuModel, ImuSimulator};
+use crate::imu::model::ImuModel;
+use crate::sim::imu_model::ImuSimulator;
 use nalgebra::Vector3;
 
 /// Error sources of one triad of gyros and one of accelerometers.

@@ -16,10 +16,11 @@ use super::{
     VerticalChannel, level_rotation,
 };
 use crate::earth::{EarthModel, Geodetic};
+use crate::imu::model::ImuModel;
 use crate::nav::{LocalLevel, Mechanization, NavState};
 use crate::rotation::rotation_vector_from_quaternion;
 use crate::sim::analytic::{self, Trajectory};
-use crate::sim::imu_model::{ImuModel, ImuSimulator};
+use crate::sim::imu_model::ImuSimulator;
 use nalgebra::{UnitQuaternion, Vector3, Vector6};
 use std::f64::consts::{PI, TAU};
 

@@ -3,6 +3,14 @@
 //! Convention (KF-GINS, sidereon `ImuSampleKind::Increment`): a sample tagged `t`
 //! holds the angle increment `dtheta` [rad] and velocity increment `dvel` [m/s]
 //! integrated over the interval `(t - dt, t]`, in body axes front-right-down (FRD).
+//!
+//! Beside them, what describes a sensor rather than simulates one: the IMU error
+//! model's parameters ([`model`]) and the seeded random stream ([`random`]) that every
+//! random draw of the crate comes from, so that `nav`, `filter` and `align` need not
+//! import `sim`.
+
+pub mod model;
+pub mod random;
 
 use nalgebra::{Matrix3, Vector3};
 
