@@ -16,7 +16,9 @@ use schuler::filter::{GnssFix, Layout};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
-use schuler::session::{Aid, MechanizationConfig, Session, SessionConfig, Start, Summary};
+use schuler::session::{
+    Aid, MechanizationConfig, Session, SessionConfig, SessionError, Start, Summary,
+};
 use std::path::PathBuf;
 
 /// Everything a run needs besides its aiding, validated.
@@ -92,7 +94,8 @@ where
     I: Iterator<Item = Result<ImuSample, InputError>>,
 {
     let out = &settings.out;
-    let mut session = Session::new(earth, settings.session_config(aiding), start)?;
+    let mut session =
+        Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
     let nav_name = aiding.map_or("nav.txt", |a| a.names.nav);
     let writer = NavWriter::create_named(out, nav_name, settings.week, &earth)?;
     let files = match aiding {
@@ -170,4 +173,88 @@ fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {
     let fixes = a.fixes.iter().map(|f: &GnssFix| Aid::Gnss(*f));
     let baro = a.baro.iter().map(|&(t, h)| Aid::Baro { t, h });
     fixes.chain(baro).chain(a.vehicle.aids())
+}
+
+/// The flag of `nav` that sets a session configuration field.
+fn flag_of(field: &str) -> &'static str {
+    const FLAGS: [(&str, &str); 27] = [
+        ("mechanization.auto_latitude", "--auto-latitude"),
+        ("mechanization.hysteresis", "--auto-hysteresis"),
+        ("output_rate", "--output-rate"),
+        ("filter.integration.noise.arw", "--arw"),
+        ("filter.integration.noise.vrw", "--vrw"),
+        ("filter.integration.noise.gyro_bias", "--gyro-bias-std"),
+        ("filter.integration.noise.accel_bias", "--accel-bias-std"),
+        (
+            "filter.integration.noise.gyro_bias_walk",
+            "--gyro-bias-instability",
+        ),
+        (
+            "filter.integration.noise.accel_bias_walk",
+            "--accel-bias-instability",
+        ),
+        ("filter.integration.noise.gyro_scale", "--gyro-scale-std"),
+        ("filter.integration.noise.accel_scale", "--accel-scale-std"),
+        ("filter.integration.noise.gyro_bias_tau", "--bias-corr-time"),
+        (
+            "filter.integration.noise.accel_bias_tau",
+            "--bias-corr-time",
+        ),
+        ("filter.integration.lever_arm", "--lever-arm"),
+        ("filter.integration.gate", "--gate"),
+        (
+            "filter.integration.propagation_interval",
+            "--propagation-interval",
+        ),
+        ("filter.integration.init_pos_std", "--init-pos-std"),
+        ("filter.integration.init_vel_std", "--init-vel-std"),
+        ("filter.integration.init_att_std", "--init-att-std"),
+        ("filter.integration.baro", "--baro-bias-std"),
+        ("filter.baro_std", "--baro-std"),
+        ("filter.vehicle.rest.std", "--zupt-std"),
+        ("filter.vehicle.rest.interval", "--zupt-interval"),
+        ("filter.vehicle.rest.zaru_std", "--zaru-std"),
+        ("filter.vehicle.nhc.std", "--nhc-std"),
+        ("filter.vehicle.odometer_std", "--odometer-std"),
+        ("filter.vehicle.odometer_scale_std", "--odometer-scale-std"),
+    ];
+    FLAGS
+        .iter()
+        .find(|(f, _)| *f == field)
+        .map_or("the configuration", |(_, flag)| flag)
+}
+
+/// A session error with its configuration field named as the flag that sets it.
+fn named_flag(e: SessionError) -> anyhow::Error {
+    match e {
+        SessionError::Config(c) => {
+            anyhow::anyhow!("{} ({}): {}", flag_of(c.field), c.field, c.reason)
+        }
+        other => anyhow::Error::new(other),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use schuler::session::{FilterConfig, SessionConfig};
+
+    /// A value the session refuses comes back under the flag that sets it.
+    #[test]
+    fn configuration_errors_name_the_flag() {
+        let noise = crate::options::GradeChoice::Tactical
+            .noise()
+            .expect("preset");
+        let mut filter = FilterConfig::new(schuler::filter::IntegrationConfig::new(noise));
+        filter.integration.init_vel_std.y = -1.0;
+        let cfg = SessionConfig {
+            filter: Some(filter),
+            ..SessionConfig::default()
+        };
+        let e = named_flag(cfg.validate().expect_err("negative std").into()).to_string();
+        assert!(
+            e.starts_with("--init-vel-std (filter.integration.init_vel_std): must be"),
+            "{e}"
+        );
+    }
 }

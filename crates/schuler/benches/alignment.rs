@@ -15,14 +15,7 @@ use schuler::sim::sensor_spec::{ImuSpec, Preset};
 use std::hint::black_box;
 
 fn bench_alignment(c: &mut Criterion) {
-    let spec = ImuSpec {
-        rate_hz: 1000.0,
-        preset: Some(Preset::Navigation),
-        gyro: Default::default(),
-        accel: Default::default(),
-        g_sensitivity: None,
-        vibration: Vec::new(),
-    };
+    let spec = ImuSpec::of_preset(1000.0, Preset::Navigation);
     let model = spec.model().expect("preset resolves");
     let pos = Geodetic::from_degrees(70.0, 30.0, 20.0);
     let c_nb = Euler::from_degrees(0.5, -1.0, 40.0).to_dcm().transpose();

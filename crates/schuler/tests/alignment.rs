@@ -26,14 +26,7 @@ use schuler::sim::sensor_spec::{ImuSpec, Preset};
 const DEG_PER_H: f64 = std::f64::consts::PI / 180.0 / 3600.0;
 
 fn navigation_grade() -> ImuModel {
-    let spec = ImuSpec {
-        rate_hz: 100.0,
-        preset: Some(Preset::Navigation),
-        gyro: Default::default(),
-        accel: Default::default(),
-        g_sensitivity: None,
-        vibration: Vec::new(),
-    };
+    let spec = ImuSpec::of_preset(100.0, Preset::Navigation);
     spec.model().expect("the navigation preset resolves")
 }
 

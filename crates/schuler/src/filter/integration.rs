@@ -476,25 +476,26 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     pub fn step_with_fixes<F: FixSource>(&mut self, raw: &ImuSample, fixes: &mut F) {
         let tol = 1e-3 * raw.dt.max(1e-9);
         let mut rest = Some(*raw);
-        while let Some(f) = fixes.peek_fix() {
+        while let Some(ft) = fixes.next_time() {
             let now = self.mech.state().t;
-            if f.t < now - tol {
+            if ft < now - tol {
                 fixes.pop_fix();
-                self.skip(f.t, SkipReason::BeforeImu);
+                self.skip(ft, SkipReason::BeforeImu);
                 continue;
             }
-            if f.t <= now + tol {
-                fixes.pop_fix();
-                self.update_gnss(&f);
+            if ft <= now + tol {
+                if let Some(f) = fixes.pop_fix() {
+                    self.update_gnss(&f);
+                }
                 continue;
             }
             let Some(r) = rest else { break };
-            if f.t > r.t + tol {
+            if ft > r.t + tol {
                 break;
             }
-            fixes.pop_fix();
-            if f.t < r.t - tol {
-                let (a, b) = split(&r, f.t);
+            let Some(f) = fixes.pop_fix() else { break };
+            if ft < r.t - tol {
+                let (a, b) = split(&r, ft);
                 self.step(&a);
                 rest = Some(b);
             } else {
@@ -755,27 +756,28 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 /// GNSS fixes in time order, taken one at a time by [`Integrator::step_with_fixes`]:
 /// a peekable iterator (a batch) or a queue that a streaming caller keeps filling.
 pub trait FixSource {
-    /// The next fix, left in place.
-    fn peek_fix(&mut self) -> Option<GnssFix>;
-    /// Drop the next fix (after it was used or skipped).
-    fn pop_fix(&mut self);
+    /// The time of the next fix, which stays in place.
+    fn next_time(&mut self) -> Option<f64>;
+    /// Take the next fix.
+    fn pop_fix(&mut self) -> Option<GnssFix>;
 }
 
 impl<I: Iterator<Item = GnssFix>> FixSource for std::iter::Peekable<I> {
-    fn peek_fix(&mut self) -> Option<GnssFix> {
-        self.peek().copied()
+    fn next_time(&mut self) -> Option<f64> {
+        self.peek().map(|f| f.t)
     }
-    fn pop_fix(&mut self) {
-        self.next();
+    fn pop_fix(&mut self) -> Option<GnssFix> {
+        self.next()
     }
 }
 
 impl FixSource for std::collections::VecDeque<GnssFix> {
-    fn peek_fix(&mut self) -> Option<GnssFix> {
-        self.front().copied()
+    #[inline]
+    fn next_time(&mut self) -> Option<f64> {
+        self.front().map(|f| f.t)
     }
-    fn pop_fix(&mut self) {
-        self.pop_front();
+    fn pop_fix(&mut self) -> Option<GnssFix> {
+        self.pop_front()
     }
 }
 

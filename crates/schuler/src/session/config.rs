@@ -138,6 +138,17 @@ pub struct VehicleConfig {
     pub heading_baseline: Option<Baseline>,
 }
 
+impl VehicleConfig {
+    /// Whether any vehicle aid is configured.
+    pub fn any(&self) -> bool {
+        self.rest.is_some()
+            || self.nhc.is_some()
+            || self.odometer_std.is_some()
+            || self.heading_baseline.is_some()
+            || self.odometer_scale_std.is_some()
+    }
+}
+
 impl Default for VehicleConfig {
     fn default() -> Self {
         Self {

@@ -176,6 +176,8 @@ struct Loop {
 pub struct Session<E: EarthModel> {
     earth: E,
     start: Start,
+    /// The start's sensor errors when there are any (free-inertial compensation).
+    compensation: Option<crate::filter::SensorEstimates>,
     core: Option<Core<E>>,
     run: Loop,
 }
@@ -187,6 +189,7 @@ impl<E: EarthModel> Session<E> {
         Ok(Self {
             earth,
             start,
+            compensation: (start.estimates != Default::default()).then_some(start.estimates),
             core: None,
             run: Loop {
                 switch: Switch::new(&config.mechanization),
@@ -194,7 +197,10 @@ impl<E: EarthModel> Session<E> {
                 last_pushed: None,
                 done: None,
                 queues: AidQueues::default(),
-                vehicle: config.filter.map(|f| VehicleRun::new(f.vehicle)),
+                vehicle: config
+                    .filter
+                    .filter(|f| f.vehicle.any())
+                    .map(|f| VehicleRun::new(f.vehicle)),
                 baro_loop: config.baro_loop.map(|b| BaroLoop::new(b.gains, b.detector)),
                 decimator: Decimator::new(config.output_rate),
                 epochs: VecDeque::new(),
@@ -298,14 +304,15 @@ impl<E: EarthModel> Session<E> {
         Ok(())
     }
 
-    /// The output epochs so far, oldest first (taken out of the session).
-    pub fn epochs(&mut self) -> std::collections::vec_deque::Drain<'_, Epoch> {
-        self.run.epochs.drain(..)
+    /// The output epochs so far, oldest first (taken out of the session as the
+    /// iterator goes; what it does not reach stays for the next call).
+    pub fn epochs(&mut self) -> impl Iterator<Item = Epoch> + '_ {
+        std::iter::from_fn(|| self.run.epochs.pop_front())
     }
 
-    /// The events so far, in order (taken out of the session).
-    pub fn events(&mut self) -> std::collections::vec_deque::Drain<'_, Event> {
-        self.run.events.drain(..)
+    /// The events so far, in order (taken out of the session as the iterator goes).
+    pub fn events(&mut self) -> impl Iterator<Item = Event> + '_ {
+        std::iter::from_fn(|| self.run.events.pop_front())
     }
 
     /// The epoch of the state now (with the filter's view), whether or not it is an
@@ -407,13 +414,14 @@ impl<E: EarthModel> Session<E> {
     }
 
     /// Integrate one sample (the first starts the navigation).
+    #[inline]
     fn integrate(&mut self, s: &ImuSample) {
         let run = &mut self.run;
         let Some(core) = self.core.as_mut() else {
             self.core = Some(run.begin(self.earth, &self.start, s));
             return;
         };
-        let estimates = &self.start.estimates;
+        let estimates = self.compensation.as_ref();
         match core {
             Core::Ned(m) => run.free_step(m, estimates, s),
             Core::Wander(m) => run.free_step(m, estimates, s),
@@ -422,7 +430,8 @@ impl<E: EarthModel> Session<E> {
         }
         run.samples += 1;
         run.done = Some((s.t, s.dt));
-        if run.switch.due(core.kind(), core.sin_lat())
+        if run.switch.auto
+            && run.switch.due(core.kind(), core.sin_lat())
             && let Some(old) = self.core.take()
         {
             let (new, handover) = old.handed_over();
@@ -563,18 +572,18 @@ impl Loop {
         self.epochs.push_back(epoch_of(core));
     }
 
-    /// One sample of free-inertial navigation (with the baro loop when configured).
+    /// One sample of free-inertial navigation (with the baro loop when configured),
+    /// compensated with `estimates` when there are any.
     #[inline]
     fn free_step<M: ErrorFrame>(
         &mut self,
         m: &mut M,
-        estimates: &crate::filter::SensorEstimates,
+        estimates: Option<&crate::filter::SensorEstimates>,
         s: &ImuSample,
     ) {
-        if *estimates == Default::default() {
-            m.step(s);
-        } else {
-            m.step(&estimates.compensate(s));
+        match estimates {
+            None => m.step(s),
+            Some(e) => m.step(&e.compensate(s)),
         }
         if let Some(l) = self.baro_loop.as_mut() {
             let early = s.t - 0.5 * s.dt;

@@ -31,8 +31,11 @@ pub struct Epoch {
 /// The filter's uncertainty and sensor-error estimates at an output epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FilterEpoch {
+    /// Covariances of position, velocity (NED, m² and m²/s²) and attitude error
+    /// (about north, east, down, rad²).
+    pub nav_cov: [Matrix3<f64>; 3],
     /// Standard deviations of position, velocity (NED, m and m/s) and attitude
-    /// (about north, east, down, rad).
+    /// (about north, east, down, rad): square roots of the covariances' diagonals.
     pub nav_std: [Vector3<f64>; 3],
     /// Estimated sensor errors.
     pub estimates: SensorEstimates,
@@ -47,8 +50,10 @@ impl FilterEpoch {
         let p = integ.covariance();
         let l = integ.layout();
         let std = |o: Option<usize>| o.map_or(Vector3::zeros(), |o| std3(p, o));
+        let nav_cov = integ.nav_covariance();
         Self {
-            nav_std: integ.nav_std(),
+            nav_cov,
+            nav_std: nav_cov.map(|p| p.diagonal().map(|v| v.max(0.0).sqrt())),
             estimates: integ.estimates(),
             sensor_std: [
                 std(Some(Layout::GYRO_BIAS)),
@@ -132,10 +137,12 @@ impl Decimator {
         match self.rate {
             None => true,
             Some(r) => {
-                let slot = ((t + 1e-3 * dt) * r).floor();
-                let take = slot > self.last_slot;
+                // `floor(x) > last` is `x >= last + 1` for an integer `last`: the
+                // floor is taken only at an output epoch.
+                let x = (t + 1e-3 * dt) * r;
+                let take = x >= self.last_slot + 1.0;
                 if take {
-                    self.last_slot = slot;
+                    self.last_slot = x.floor();
                 }
                 take
             }

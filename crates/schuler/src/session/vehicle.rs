@@ -71,7 +71,7 @@ impl VehicleRun {
         queues: &mut AidQueues,
         s: &ImuSample,
     ) {
-        let c = self.cfg;
+        let c = &self.cfg;
         let (early, due) = (s.t - 0.5 * s.dt, s.t + 0.5 * s.dt);
         if let Some(std) = c.odometer_std {
             while let Some(&(t, speed)) = queues.odometer.front().filter(|r| r.0 <= due) {
@@ -99,8 +99,8 @@ impl VehicleRun {
             integ.update_non_holonomic(&c.mount, std);
             self.last_nhc = s.t;
         }
-        if let Some(rest) = &c.rest {
-            self.rest(integ, queues, rest, s);
+        if let Some(rest) = c.rest {
+            self.rest(integ, queues, &rest, s);
         }
     }
 

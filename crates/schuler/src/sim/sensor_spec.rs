@@ -280,6 +280,19 @@ pub struct ImuSpec {
 }
 
 impl ImuSpec {
+    /// The preset alone at `rate_hz` [Hz]: no overrides, no g-sensitivity, no
+    /// vibration.
+    pub fn of_preset(rate_hz: f64, preset: Preset) -> Self {
+        Self {
+            rate_hz,
+            preset: Some(preset),
+            gyro: Default::default(),
+            accel: Default::default(),
+            g_sensitivity: None,
+            vibration: Vec::new(),
+        }
+    }
+
     /// The spec with the preset folded in (what was actually used, for the record).
     pub fn resolved_spec(&self) -> ImuSpec {
         let (g, a) = self.preset.unwrap_or(Preset::Perfect).specs();
