@@ -123,6 +123,9 @@ pub struct Outputs {
     /// The filter's files, when a filter runs.
     pub filter: Option<FilterFiles>,
     last_written: f64,
+    /// The first epoch whose heading standard deviation fell below 1°: its time and
+    /// heading [rad].
+    heading_settled: Option<(f64, f64)>,
 }
 
 impl Outputs {
@@ -132,6 +135,7 @@ impl Outputs {
             nav,
             filter,
             last_written: f64::NAN,
+            heading_settled: None,
         }
     }
 
@@ -142,6 +146,12 @@ impl Outputs {
             wander_azimuth: e.wander_azimuth,
         })?;
         self.last_written = e.state.t;
+        if let Some(f) = &e.filter
+            && self.heading_settled.is_none()
+            && f.nav_std[2].z < 1f64.to_radians()
+        {
+            self.heading_settled = Some((e.state.t, e.state.euler().heading_0_2pi()));
+        }
         if let (Some(files), Some(f)) = (self.filter.as_mut(), &e.filter) {
             let [sp, sv, sa] = f.nav_std;
             let [gb, ab, gs, as_] = f.sensor_std;
@@ -225,6 +235,9 @@ pub struct Driven {
     pub epochs: u64,
     /// The filter's files, still open (for `rejected.csv` and the report).
     pub filter: Option<FilterFiles>,
+    /// The first output epoch whose heading standard deviation was below 1°: its time
+    /// [s] and heading [rad].
+    pub heading_settled: Option<(f64, f64)>,
 }
 
 /// Pushes `samples` into `session`, writing what comes out to `out`; `on_sample` is
@@ -284,6 +297,7 @@ where
         finished,
         failure,
         epochs,
+        heading_settled: out.heading_settled,
         filter: out.filter,
     }))
 }

@@ -77,6 +77,9 @@ pub struct RunSummary {
     pub epochs: u64,
     /// The consistency summary to print (aided runs).
     pub report_text: String,
+    /// The first output epoch whose heading standard deviation was below 1°: its time
+    /// [s] and heading [rad].
+    pub heading_settled: Option<(f64, f64)>,
 }
 
 /// Navigate `samples` (the first carries `start`) on `earth` with the settings and,
@@ -126,6 +129,7 @@ where
         failure,
         epochs,
         filter,
+        heading_settled,
     } = driven;
     let mut report_text = String::new();
     if let (Some(a), Some(files)) = (aiding, filter) {
@@ -165,6 +169,7 @@ where
         nav: finished.summary,
         epochs,
         report_text,
+        heading_settled,
     })
 }
 

@@ -99,6 +99,12 @@ pub struct NavArgs {
     /// removed; --init-att is then not needed. Writes align.json beside nav.txt.
     #[arg(long)]
     pub align: bool,
+    /// How the run starts: `given` (default: --init-pos, --init-att) or `gnss`: in
+    /// motion, from the GNSS fixes alone (position and velocity from the fixes, heading
+    /// from the course: a land vehicle driving forward along the IMU's x axis is
+    /// assumed; roll and pitch from the accelerometers); needs --gnss.
+    #[arg(long, value_enum)]
+    pub init: Option<InitChoice>,
     /// Run a KF-GINS configuration file (its paths, initial state, IMU noise and lever
     /// arm, in its units) and write KF-GINS's output files into its outputpath; the
     /// other options do not apply.
@@ -134,8 +140,20 @@ struct NavConfig {
     auto_latitude: Option<f64>,
     auto_hysteresis: Option<f64>,
     align: Option<bool>,
+    init: Option<InitChoice>,
     alignment: Option<AlignOptions>,
     aiding: Option<AidingOptions>,
+}
+
+/// How a run starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitChoice {
+    /// From --init-pos, --init-vel and --init-att (or --align).
+    #[default]
+    Given,
+    /// In motion, from the GNSS fixes (land vehicles driving forward).
+    Gnss,
 }
 
 fn load_config(path: &Path) -> Result<NavConfig> {
@@ -187,6 +205,8 @@ pub struct NavPlan {
     pub settings: NavSettings,
     /// Whether to align first (`--align`).
     pub align: bool,
+    /// How the run starts.
+    pub init: InitChoice,
     /// The alignment options (`--imu-grade` among them serves the filter too).
     pub alignment: AlignOptions,
     /// The aiding options.
@@ -261,6 +281,12 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
         None => NavConfig::default(),
     };
     let align_on = args.align || cfg.align.unwrap_or(false);
+    let init = args.init.or(cfg.init).unwrap_or_default();
+    if init == InitChoice::Gnss && align_on {
+        bail!("--init gnss starts in motion; --align starts at rest: give one of them");
+    }
+    // In motion the fixes give the position and the course the attitude.
+    let in_motion = init == InitChoice::Gnss;
     let settings = NavSettings {
         imu: args
             .imu
@@ -268,9 +294,13 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
             .or(cfg.imu.clone())
             .context("no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config)")?,
         read: read_options(&args, &cfg)?,
-        init_pos: init_pos(&args, &cfg)?,
+        init_pos: if in_motion {
+            Geodetic::new(0.0, 0.0, 0.0)
+        } else {
+            init_pos(&args, &cfg)?
+        },
         init_vel: Vector3::from(args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3])).0),
-        init_att: init_att(&args, &cfg, align_on)?,
+        init_att: init_att(&args, &cfg, align_on || in_motion)?,
         output_rate: rate("output-rate", args.output_rate.or(cfg.output_rate))?,
         out: args
             .out
@@ -296,6 +326,7 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
     Ok(NavPlan {
         settings,
         align: align_on,
+        init,
         alignment,
         aiding,
     })
@@ -342,6 +373,54 @@ fn align_first(
     Ok((Start::from_alignment(&a), samples[carrier..].to_vec()))
 }
 
+/// With `--init gnss`: the start in motion from the fixes and the IMU samples up to
+/// a few seconds past the first pair of fixes far enough apart
+/// ([`schuler::align::in_motion`]), printed; the filter's prior becomes its standard
+/// deviations. Returns the start and the samples from its carrier on.
+fn start_in_motion(
+    settings: &NavSettings,
+    reader: &mut ImuReader<std::io::BufReader<std::fs::File>>,
+    aiding: Option<&mut Aiding>,
+) -> Result<(Start, Vec<ImuSample>)> {
+    use schuler::align::in_motion::{InMotionConfig, course_pair, start_in_motion};
+    let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
+        bail!("--init gnss needs GNSS fixes (--gnss FILE)");
+    };
+    let cfg = InMotionConfig::default();
+    let earth = Wgs84;
+    let (_, j) = course_pair(&earth, &aiding.fixes, &cfg)
+        .with_context(|| format!("--init gnss: {}", settings.imu.display()))?;
+    let until = aiding.fixes[j].t + cfg.settle + cfg.level_window;
+    let first = match reader.next() {
+        Some(s) => s?,
+        None => bail!(
+            "{}: no IMU sample in the requested time window",
+            settings.imu.display()
+        ),
+    };
+    let seconds = (until - first.t).max(0.0);
+    let mut samples = vec![first];
+    samples.extend(crate::alignment::read_stage(reader, seconds)?);
+    let m = start_in_motion(&earth, &samples, &aiding.fixes, &cfg)
+        .with_context(|| format!("--init gnss: {}", settings.imu.display()))?;
+    let e = m.state.euler();
+    println!(
+        "started in motion at t = {} s from the fixes at {} and {} s: {:.2} m/s, heading {:.2} ± {:.2} deg (the course: forward motion along the IMU's x axis assumed), roll {:.2} pitch {:.2} ± {:.2} deg",
+        m.state.t,
+        aiding.fixes[m.fixes.0].t,
+        aiding.fixes[m.fixes.1].t,
+        m.speed,
+        e.heading_0_2pi().to_degrees(),
+        m.att_std.z.to_degrees(),
+        e.roll.to_degrees(),
+        e.pitch.to_degrees(),
+        m.att_std.x.to_degrees()
+    );
+    let filter = &mut aiding.filter;
+    *filter = Prior::from_motion(&m).apply_to(*filter);
+    Ok((Start::from_motion(&m), samples[m.sample..].to_vec()))
+}
+
 /// `schuler nav`.
 pub fn run(args: NavArgs) -> Result<()> {
     if let Some(path) = &args.kf_gins_config {
@@ -350,6 +429,7 @@ pub fn run(args: NavArgs) -> Result<()> {
     let NavPlan {
         settings,
         align,
+        init,
         alignment,
         aiding: aiding_opts,
     } = parse_nav_args(args)?;
@@ -376,10 +456,10 @@ pub fn run(args: NavArgs) -> Result<()> {
         1.0 / reader.nominal_dt()
     );
     let bar = progress_bar(&settings.imu);
-    let (start, head) = if align {
-        align_first(&settings, &alignment, &mut reader, aiding.as_mut(), &bar)?
-    } else {
-        (settings.start(), Vec::new())
+    let (start, head) = match (align, init) {
+        (true, _) => align_first(&settings, &alignment, &mut reader, aiding.as_mut(), &bar)?,
+        (false, InitChoice::Gnss) => start_in_motion(&settings, &mut reader, aiding.as_mut())?,
+        (false, InitChoice::Given) => (settings.start(), Vec::new()),
     };
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
@@ -404,7 +484,12 @@ pub fn run(args: NavArgs) -> Result<()> {
     bar.finish_and_clear();
     let secs = started.elapsed().as_secs_f64();
     match &aiding {
-        Some(a) => print_aided(&settings, a, &summary, secs),
+        Some(a) => {
+            if init == InitChoice::Gnss {
+                print_heading_settled(&summary);
+            }
+            print_aided(&settings, a, &summary, secs)
+        }
         None => {
             let report = reader.gaps();
             if !report.is_empty() {
@@ -469,6 +554,21 @@ fn print_aided(
         settings.out.join("nav.txt").display()
     );
     Ok(())
+}
+
+/// When the heading of a start in motion converged (its standard deviation below 1°).
+fn print_heading_settled(summary: &RunSummary) {
+    let t0 = summary.nav.t_first;
+    match summary.heading_settled {
+        Some((t, yaw)) => println!(
+            "heading converged (std below 1 deg) at t = {t} s, {:.1} s after the start: {:.3} deg",
+            t - t0,
+            yaw.to_degrees()
+        ),
+        None => println!(
+            "heading did not converge below 1 deg std (turns and accelerations make it observable)"
+        ),
+    }
 }
 
 /// The hand-overs between mechanizations, one line each.

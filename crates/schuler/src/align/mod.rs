@@ -16,6 +16,7 @@
 
 pub mod coarse;
 pub mod fine;
+pub mod in_motion;
 pub mod prefilter;
 pub mod rest;
 

@@ -4,6 +4,7 @@
 
 use super::FilterConfig;
 use crate::align::Alignment;
+use crate::align::in_motion::InMotionStart;
 use crate::filter::{IntegrationConfig, SensorEstimates};
 use crate::nav::NavState;
 use nalgebra::{SMatrix, Vector3};
@@ -39,6 +40,13 @@ impl Start {
                 ..SensorEstimates::default()
             },
         }
+    }
+}
+
+impl Start {
+    /// The start a start in motion gives (no sensor error known).
+    pub fn from_motion(m: &InMotionStart) -> Self {
+        Self::at(m.state)
     }
 }
 
@@ -82,6 +90,18 @@ impl Prior {
             att_std: a.attitude_std,
             bias_std: Some([a.gyro_bias_std, a.accel_bias_std]),
             att_bias_cov,
+        }
+    }
+
+    /// After a start in motion: the standard deviations it derived, the biases at the
+    /// IMU model's prior.
+    pub fn from_motion(m: &InMotionStart) -> Self {
+        Self {
+            pos_std: m.pos_std,
+            vel_std: m.vel_std,
+            att_std: m.att_std,
+            bias_std: None,
+            att_bias_cov: None,
         }
     }
 
