@@ -170,6 +170,13 @@ impl Outputs {
     }
 
     fn event(&mut self, e: Event) -> Result<()> {
+        if let Event::Envelope { t, what } = &e {
+            eprintln!(
+                "warning: at t = {t} s the solution left the physical envelope: {what} \
+                 (a wrong input: axes, units, columns, clock? or a diverged free-inertial run)"
+            );
+            return Ok(());
+        }
         let Some(files) = self.filter.as_mut() else {
             return Ok(());
         };
@@ -206,7 +213,7 @@ impl Outputs {
                 ),
             ),
             Event::Ignored { t, kind, reason } => (t, format!("{t},{kind},{reason},,\n")),
-            Event::Handover(_) => return Ok(()),
+            Event::Handover(_) | Event::Envelope { .. } => return Ok(()),
         };
         files.refused.push(row);
         Ok(())

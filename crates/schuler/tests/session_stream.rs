@@ -265,3 +265,37 @@ fn aids_the_configuration_cannot_use_are_reported() {
     assert_eq!(end.summary.ignored, 1);
     assert_eq!(end.summary.samples, 9);
 }
+
+/// A solution outside the physical envelope is reported once per bound, with its
+/// time, and the run goes on: a start at 1200 m/s (above Mach 3) and 2 km below the
+/// ellipsoid, free-inertial.
+#[test]
+fn leaving_the_envelope_is_reported_once() {
+    let log = log();
+    let mut start = log.start;
+    start.state.v_n.x += 1200.0;
+    start.state.pos.h = -2000.0;
+    let cfg = SessionConfig {
+        output_rate: Some(1.0),
+        ..SessionConfig::default()
+    };
+    let mut s = Session::new(Wgs84, cfg, start).expect("free");
+    let mut warnings = Vec::new();
+    for x in &log.imu[..3000] {
+        s.push_imu(*x).expect("in order");
+        s.epochs().for_each(drop);
+        warnings.extend(s.events().filter_map(|e| match e {
+            Event::Envelope { t, what } => Some((t, what)),
+            _ => None,
+        }));
+    }
+    let end = s.finish().expect("samples");
+    assert_eq!(end.summary.samples, 2999);
+    assert_eq!(end.summary.envelope_warnings, 2);
+    let [(t0, low), (t1, fast)] = warnings.as_slice() else {
+        panic!("two warnings: {warnings:?}");
+    };
+    assert_eq!((*t0, *t1), (0.0, 0.0));
+    assert!(low.starts_with("height -2000.0 m below -1000 m"), "{low}");
+    assert!(fast.starts_with("speed 12"), "{fast}");
+}

@@ -204,6 +204,29 @@ pub struct BaroLoopConfig {
     pub detector: DetectorConfig,
 }
 
+/// The physical envelope of a solution: leaving it means the navigation has failed (a
+/// wrong input, a diverged free-inertial solution), and the session warns once per
+/// bound with the time ([`super::Event::Envelope`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Envelope {
+    /// Lowest plausible height [m] (default −1 km: below the Dead Sea shore by far).
+    pub min_height: f64,
+    /// Highest plausible height [m] (default 100 km: the edge of space).
+    pub max_height: f64,
+    /// Highest plausible speed [m/s] (default Mach 3 at sea level, 1029 m/s).
+    pub max_speed: f64,
+}
+
+impl Default for Envelope {
+    fn default() -> Self {
+        Self {
+            min_height: -1000.0,
+            max_height: 100_000.0,
+            max_speed: 3.0 * 343.0,
+        }
+    }
+}
+
 /// Everything a session needs besides its start.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SessionConfig {
@@ -224,6 +247,8 @@ pub struct SessionConfig {
     /// Cadence [Hz] of the filter's snapshots (sensor errors, covariance, NEES
     /// against a truth) kept for reports; default 1 Hz.
     pub snapshot_rate: f64,
+    /// The envelope checked at every output epoch; `None`: no check (space, missiles).
+    pub envelope: Option<Envelope>,
 }
 
 impl Default for SessionConfig {
@@ -235,6 +260,7 @@ impl Default for SessionConfig {
             filter: None,
             baro_loop: None,
             snapshot_rate: 1.0,
+            envelope: Some(Envelope::default()),
         }
     }
 }
@@ -311,6 +337,14 @@ impl SessionConfig {
         }
         non_negative("reorder_window", self.reorder_window)?;
         positive("snapshot_rate", self.snapshot_rate)?;
+        if let Some(e) = &self.envelope
+            && !(e.min_height < e.max_height && e.max_speed > 0.0)
+        {
+            return Err(ConfigError::new(
+                "envelope",
+                format!("needs min_height < max_height and a positive max_speed, got {e:?}"),
+            ));
+        }
         if let Some(b) = &self.baro_loop {
             if self.filter.is_some() {
                 return Err(ConfigError::new(

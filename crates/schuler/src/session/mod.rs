@@ -29,7 +29,7 @@ mod vehicle;
 
 pub use aid::Aid;
 pub use config::{
-    BaroLoopConfig, ConfigError, FilterConfig, MechanizationChoice, MechanizationConfig,
+    BaroLoopConfig, ConfigError, Envelope, FilterConfig, MechanizationChoice, MechanizationConfig,
     MechanizationKind, RestConfig, RestSource, SessionConfig, VehicleConfig,
 };
 pub use output::{Decimator, Epoch, Event, FilterEpoch, Handover, Snapshot};
@@ -113,6 +113,8 @@ pub struct Summary {
     pub late: u64,
     /// Aids the configuration had no use for.
     pub ignored: u64,
+    /// Envelope bounds the solution crossed.
+    pub envelope_warnings: u64,
     /// GNSS positions accepted without the gate after consecutive refusals.
     pub gate_resets: u64,
     /// Mean normalized innovation squared per dimension of the accepted measurements
@@ -169,6 +171,8 @@ struct Loop {
     skipped_free: u64,
     nis: (f64, usize),
     ended: bool,
+    /// Which envelope bounds were crossed (low height, high height, speed).
+    left_envelope: [bool; 3],
 }
 
 /// A navigation session (module doc).
@@ -218,6 +222,7 @@ impl<E: EarthModel> Session<E> {
                 skipped_free: 0,
                 nis: (0.0, 0),
                 ended: false,
+                left_envelope: [false; 3],
                 cfg: config,
             },
         })
@@ -401,6 +406,7 @@ impl<E: EarthModel> Session<E> {
                 counts,
                 late: run.late,
                 ignored: run.ignored,
+                envelope_warnings: run.left_envelope.iter().filter(|x| **x).count() as u64,
                 gate_resets: run.gate_resets,
                 mean_nis_per_dof: if dof > 0 { sum / dof as f64 } else { f64::NAN },
                 layout,
@@ -569,7 +575,31 @@ impl Loop {
             Core::FilterWander(i) => i.record_output(),
             _ => {}
         }
-        self.epochs.push_back(epoch_of(core));
+        let epoch = epoch_of(core);
+        self.check_envelope(&epoch.state);
+        self.epochs.push_back(epoch);
+    }
+
+    /// Warn once per bound when `state` is outside the envelope.
+    fn check_envelope(&mut self, state: &NavState) {
+        let Some(e) = self.cfg.envelope else { return };
+        let speed = state.v_n.norm();
+        let h = state.pos.h;
+        let crossed = [
+            (h < e.min_height || h.is_nan())
+                .then(|| format!("height {h:.1} m below {} m", e.min_height)),
+            (h > e.max_height).then(|| format!("height {h:.1} m above {} m", e.max_height)),
+            (speed > e.max_speed || speed.is_nan())
+                .then(|| format!("speed {speed:.1} m/s above {} m/s", e.max_speed)),
+        ];
+        for (k, what) in crossed.into_iter().enumerate() {
+            if let Some(what) = what
+                && !self.left_envelope[k]
+            {
+                self.left_envelope[k] = true;
+                self.events.push_back(Event::Envelope { t: state.t, what });
+            }
+        }
     }
 
     /// One sample of free-inertial navigation (with the baro loop when configured),

@@ -111,6 +111,13 @@ pub enum Event {
     },
     /// A hand-over between mechanizations.
     Handover(Handover),
+    /// The solution left the physical envelope (reported once per bound).
+    Envelope {
+        /// Time [s].
+        t: f64,
+        /// Which bound, with the value: e.g. `height -1234.5 m below -1000 m`.
+        what: String,
+    },
 }
 
 /// Decides which epochs to emit: every one, or the first epoch at or after each
