@@ -163,6 +163,10 @@ pub struct SensorEstimates {
     pub baro_bias: f64,
     /// Odometer scale-factor error (reading = (1 + k) speed).
     pub odometer_scale: f64,
+    /// Mounting errors of the vehicle frame removed from the configured mount
+    /// (rotation vector in the vehicle frame: 0, pitch, yaw) [rad]
+    /// ([`VehicleMount::corrected`]).
+    pub mounting: Vector3<f64>,
 }
 
 impl SensorEstimates {
@@ -361,6 +365,27 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         let mut p = DMatrix::zeros(n, n);
         p.view_mut((0, 0), (old, old)).copy_from(&self.kf.p);
         p[(old, old)] = std * std;
+        self.kf.p = p;
+        if self.smoother.is_some() {
+            self = self.with_smoother();
+        }
+        self
+    }
+
+    /// Estimate the vehicle frame's pitch and yaw mounting relative to the configured
+    /// mount, prior standard deviation `std` [rad] each, constant (two states appended
+    /// to the layout; the smoother's record, if any, restarts).
+    pub fn with_mounting(mut self, std: f64) -> Self {
+        if self.model.layout.mounting.is_some() {
+            return self;
+        }
+        let old = self.model.layout.n;
+        self.model.layout = self.model.layout.with_mounting();
+        let n = self.model.layout.n;
+        let mut p = DMatrix::zeros(n, n);
+        p.view_mut((0, 0), (old, old)).copy_from(&self.kf.p);
+        p[(old, old)] = std * std;
+        p[(old + 1, old + 1)] = std * std;
         self.kf.p = p;
         if self.smoother.is_some() {
             self = self.with_smoother();
@@ -664,6 +689,9 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if let Some(o) = l.odometer_scale {
             self.estimates.odometer_scale += dx[o];
         }
+        if let Some(o) = l.mounting {
+            self.estimates.mounting += Vector3::new(0.0, dx[o], dx[o + 1]);
+        }
     }
 
     /// Apply a barometric height `h_baro` [m] with standard deviation `std` now (the
@@ -712,7 +740,8 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     pub fn update_non_holonomic(&mut self, mount: &VehicleMount, std: f64) -> bool {
         self.propagate();
         let frame = self.mech.frame();
-        let m = vehicle::non_holonomic(&self.model.layout, &frame, mount, &self.w_ib_b, std);
+        let mount = mount.corrected(&self.estimates.mounting);
+        let m = vehicle::non_holonomic(&self.model.layout, &frame, &mount, &self.w_ib_b, std);
         self.apply(frame.t, m)
     }
 
@@ -723,7 +752,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         let m = vehicle::odometer(
             &self.model.layout,
             &self.mech.frame(),
-            mount,
+            &mount.corrected(&self.estimates.mounting),
             &self.w_ib_b,
             speed,
             self.estimates.odometer_scale,

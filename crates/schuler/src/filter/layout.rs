@@ -20,6 +20,9 @@ pub struct Layout {
     pub attitude_ref: Option<usize>,
     /// Odometer scale-factor error (1), if estimated.
     pub odometer_scale: Option<usize>,
+    /// Mounting errors of the vehicle frame (2: pitch, then yaw, about the vehicle's
+    /// y and z axes), if estimated.
+    pub mounting: Option<usize>,
 }
 
 impl Layout {
@@ -43,6 +46,7 @@ impl Layout {
             baro_bias: None,
             attitude_ref: None,
             odometer_scale: None,
+            mounting: None,
         }
     }
 
@@ -72,6 +76,13 @@ impl Layout {
     pub fn with_odometer_scale(mut self) -> Self {
         self.odometer_scale = Some(self.n);
         self.n += 1;
+        self
+    }
+
+    /// Add the vehicle frame's pitch and yaw mounting errors.
+    pub fn with_mounting(mut self) -> Self {
+        self.mounting = Some(self.n);
+        self.n += 2;
         self
     }
 
@@ -105,6 +116,10 @@ impl Layout {
             if let Some(o) = at {
                 names[o] = name.into();
             }
+        }
+        if let Some(o) = self.mounting {
+            names[o] = "mount_pitch".into();
+            names[o + 1] = "mount_yaw".into();
         }
         names
     }

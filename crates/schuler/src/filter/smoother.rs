@@ -181,6 +181,9 @@ impl SmootherLog {
                 if let Some(o) = layout.odometer_scale {
                     est.odometer_scale += err[o];
                 }
+                if let Some(o) = layout.mounting {
+                    est.mounting += Vector3::new(0.0, err[o], err[o + 1]);
+                }
                 Smoothed {
                     state: nav_state_from_ecef(earth, t, &r, &v, &q),
                     estimates: est,

@@ -21,6 +21,11 @@
 //!   attitude error for a metre-long arm: Dissanayake et al. 2001, IEEE Trans.
 //!   Robotics and Automation 17(5); Groves 2013 ch. 15, zero updates and motion
 //!   constraints).
+//! - Mounting errors: with the vehicle frame assumed at `Ĉ_vb = (I − [μ×]) C_vb` (`μ`
+//!   in the vehicle frame), `v̂_v = v_v + [v_v×] μ`; on a forward drive `v_v ≈ (s, 0,
+//!   0)` this is `(0, −s μ_z, s μ_y)`: the constraint's lateral row sees the yaw
+//!   misalignment, its vertical row the pitch one (the roll one turns the constrained
+//!   plane into itself and is not observable, so it is not a state).
 //! - Non-holonomic constraint (NHC): a land vehicle's wheels neither slip sideways nor
 //!   leave the road, `z = (v̂_v,y, v̂_v,z) − 0`: rows 2 and 3 of `δv_v`.
 //! - Odometer speed `s = (1 + k) v_v,x + v` with a scale-factor error `k` (a state
@@ -70,6 +75,19 @@ impl VehicleMount {
     /// IMU axes along the vehicle's (zero mounting angles, lever arm zero).
     pub fn aligned() -> Self {
         Self::new(Euler::default(), Vector3::zeros())
+    }
+
+    /// The mount with the estimated mounting errors `mu` (rotation vector in the
+    /// vehicle frame, `Ĉ_vb = (I − [μ×]) C_vb`) removed: `C_vb ← R(μ) Ĉ_vb`, i.e.
+    /// `q_vb ← q_vb ⊗ q(−μ)`.
+    pub fn corrected(&self, mu: &Vector3<f64>) -> Self {
+        if *mu == Vector3::zeros() {
+            return *self;
+        }
+        Self {
+            q_vb: self.q_vb * crate::rotation::quaternion_from_rotation_vector(&-mu),
+            ..*self
+        }
     }
 }
 
@@ -174,7 +192,16 @@ pub fn vehicle_velocity(
     if let Some(o) = layout.gyro_scale {
         put_rows(&mut h, o, &(lw * Matrix3::from_diagonal(w_ib_b)));
     }
-    (c_vb * v_b, h)
+    let v_v = c_vb * v_b;
+    if let Some(o) = layout.mounting {
+        // v̂_v = (I − [μ×]) v_v = v_v + [v_v×] μ: the pitch and yaw columns.
+        let s = skew(&v_v);
+        for r in 0..3 {
+            h[(r, o)] = s[(r, 1)];
+            h[(r, o + 1)] = s[(r, 2)];
+        }
+    }
+    (v_v, h)
 }
 
 /// The non-holonomic constraint: no lateral or vertical velocity of the mount's
