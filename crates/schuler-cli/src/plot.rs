@@ -21,6 +21,17 @@ use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
+/// Time axis: hours for runs of 2 h or more, minutes from 10 min, else seconds.
+pub(crate) fn time_axis(duration: f64) -> (f64, &'static str) {
+    if duration >= 7200.0 {
+        (3600.0, "t [h]")
+    } else if duration >= 600.0 {
+        (60.0, "t [min]")
+    } else {
+        (1.0, "t [s]")
+    }
+}
+
 /// How a series is stroked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LineStyle {

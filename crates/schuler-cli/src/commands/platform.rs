@@ -14,7 +14,7 @@
 //! `tilt_east.svg`, `heading.svg`), the table of errors at 1 h (or at the end of a
 //! shorter run) as `table.csv` and `table.md`, and `summary.json`.
 
-use crate::plot::{LineStyle, Plot};
+use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use nalgebra::{Vector3, Vector6};
 use schuler::earth::{EarthModel, Sphere, Wgs84};
@@ -423,7 +423,7 @@ fn write_errors_csv(path: &Path, c: &Comparison) -> Result<()> {
 /// above every other's (the gyro-free INS, usually) is drawn only until it passes 1.5
 /// times the next peak, and labelled with that time, so the others keep the scale.
 fn write_plots(dir: &Path, c: &Comparison) -> Result<()> {
-    let (tscale, tlabel) = super::channel::time_axis(c.times[c.times.len() - 1] - c.times[0]);
+    let (tscale, tlabel) = time_axis(c.times[c.times.len() - 1] - c.times[0]);
     let t: Vec<f64> = c.times.iter().map(|x| (x - c.times[0]) / tscale).collect();
     let styles = [LineStyle::Solid, LineStyle::Dashed, LineStyle::Dotted];
     for q in &QUANTITIES {

@@ -11,8 +11,8 @@
 //! (eigenvalues, e-fold time, settling and reconvergence times, detector counts) and the
 //! plots `dh.svg`, `dvh.svg`.
 
-use super::channel::{SphereArgs, acceleration, is_positive, length, time, time_axis, velocity};
-use crate::plot::{LineStyle, Plot};
+use crate::options::{SphereArgs, acceleration, is_positive, length, time, velocity};
+use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use schuler::channel::ChannelError;
