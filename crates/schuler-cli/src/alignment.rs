@@ -6,10 +6,11 @@ use crate::options::{EarthChoice, GradeChoice};
 use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
-use schuler::align::{AlignConfig, Alignment, HeadingSource, align};
+use schuler::align::{AlignConfig, Alignment, HeadingSource, MotionReport, align};
 use schuler::earth::{Geodetic, Sphere, Wgs84};
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
+use schuler::rotation::Euler;
 use schuler::units::{DEG_PER_H, Dimension, MGAL, parse_as_or_si};
 use serde::Deserialize;
 use std::fmt::Write as _;
@@ -153,13 +154,101 @@ fn deg3(v: &Vector3<f64>) -> [f64; 3] {
     v.map(f64::to_degrees).into()
 }
 
+/// One row of the attitude table: the stage ending at `t` [s], its roll, pitch and
+/// heading (0..360) [deg] and their standard deviations `sd` [deg].
+fn stage_row(s: &mut String, name: &str, t: f64, e: &Euler, sd: &Vector3<f64>) {
+    let _ = writeln!(
+        s,
+        "{name:6} | {t:9.2} | {:9.5} ± {:8.5} | {:9.5} ± {:8.5} | {:9.4} ± {:7.4}",
+        e.roll.to_degrees(),
+        sd.x,
+        e.pitch.to_degrees(),
+        sd.y,
+        e.heading_0_2pi().to_degrees(),
+        sd.z
+    );
+}
+
+/// The sensor biases the fine stage left unobservable at rest (their estimates stay
+/// at the prior), as `gyro bias x` etc. Sensor errors only: the attitude's prior is
+/// already the coarse stage's bias-limited result, so its ratio says nothing about
+/// observability.
+fn unobservable_biases(a: &Alignment) -> Vec<String> {
+    a.observability
+        .iter()
+        .filter(|(n, r)| *r >= schuler::align::OBSERVABLE_RATIO && n.starts_with('b'))
+        .map(|(n, _)| {
+            let axis = n.chars().last().unwrap_or('?');
+            let sensor = if n.starts_with("bg") { "gyro" } else { "accel" };
+            format!("{sensor} bias {axis}")
+        })
+        .collect()
+}
+
+/// The fine stage's gyro [deg/h] and accelerometer [mGal] bias estimates with their
+/// standard deviations, and which of them stayed unobservable.
+fn write_biases(s: &mut String, a: &Alignment) {
+    let bg = a.gyro_bias / DEG_PER_H;
+    let bgs = a.gyro_bias_std / DEG_PER_H;
+    let ba = a.accel_bias / MGAL;
+    let bas = a.accel_bias_std / MGAL;
+    let _ = writeln!(
+        s,
+        "gyro bias  [deg/h]: {:+.5} ± {:.5}, {:+.5} ± {:.5}, {:+.5} ± {:.5}",
+        bg.x, bgs.x, bg.y, bgs.y, bg.z, bgs.z
+    );
+    let _ = writeln!(
+        s,
+        "accel bias [mGal]:  {:+.1} ± {:.1}, {:+.1} ± {:.1}, {:+.1} ± {:.1}",
+        ba.x, bas.x, ba.y, bas.y, ba.z, bas.z
+    );
+    let unobservable = unobservable_biases(a);
+    let _ = writeln!(
+        s,
+        "not observable at rest (estimates stay at their prior): {}",
+        if unobservable.is_empty() {
+            "none".to_string()
+        } else {
+            unobservable.join(", ")
+        }
+    );
+}
+
+/// What the pre-filter's motion detector found, and that the stillness noise was
+/// raised to match.
+fn write_motion(s: &mut String, m: &MotionReport) {
+    if !(m.angular_motion || m.vibration) {
+        let _ = writeln!(s, "motion: none beyond the sensor noise");
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "motion detected: {}{}; the filter's stillness noise was raised to match",
+        if m.angular_motion {
+            format!(
+                "angular motion (gyro block scatter {:.2e} rad/s vs noise {:.2e})",
+                m.gyro_block_scatter.max(),
+                m.gyro_block_noise.max()
+            )
+        } else {
+            String::new()
+        },
+        if m.vibration {
+            format!(
+                "{}vibration (accel scatter {:.3} m/s^2 vs noise {:.3})",
+                if m.angular_motion { ", " } else { "" },
+                m.accel_sample_scatter.max(),
+                m.accel_sample_noise.max()
+            )
+        } else {
+            String::new()
+        }
+    );
+}
+
 /// The report printed on stdout.
 pub fn summary_text(a: &Alignment, timing: &[(&str, f64)]) -> String {
     let mut s = String::new();
-    let e = a.state.euler();
-    let c = schuler::rotation::Euler::from_quaternion(&a.coarse.q_bn);
-    let sd = a.attitude_std.map(f64::to_degrees);
-    let cd = a.coarse_std.map(f64::to_degrees);
     let lim = a.predicted_limit.map(f64::to_degrees);
     let _ = writeln!(
         s,
@@ -170,57 +259,18 @@ pub fn summary_text(a: &Alignment, timing: &[(&str, f64)]) -> String {
         s,
         "stage  | t_end [s] | roll ± std [deg]      | pitch ± std [deg]     | yaw ± std [deg]"
     );
-    let stage =
-        |s: &mut String, name: &str, t: f64, e: &schuler::rotation::Euler, sd: &Vector3<f64>| {
-            let _ = writeln!(
-                s,
-                "{name:6} | {t:9.2} | {:9.5} ± {:8.5} | {:9.5} ± {:8.5} | {:9.4} ± {:7.4}",
-                e.roll.to_degrees(),
-                sd.x,
-                e.pitch.to_degrees(),
-                sd.y,
-                e.heading_0_2pi().to_degrees(),
-                sd.z
-            );
-        };
-    stage(&mut s, "coarse", a.t_coarse, &c, &cd);
+    let coarse = Euler::from_quaternion(&a.coarse.q_bn);
+    stage_row(
+        &mut s,
+        "coarse",
+        a.t_coarse,
+        &coarse,
+        &a.coarse_std.map(f64::to_degrees),
+    );
     if a.fine.is_some() {
-        stage(&mut s, "fine", a.t_end, &e, &sd);
-        let bg = a.gyro_bias / DEG_PER_H;
-        let bgs = a.gyro_bias_std / DEG_PER_H;
-        let ba = a.accel_bias / MGAL;
-        let bas = a.accel_bias_std / MGAL;
-        let _ = writeln!(
-            s,
-            "gyro bias  [deg/h]: {:+.5} ± {:.5}, {:+.5} ± {:.5}, {:+.5} ± {:.5}",
-            bg.x, bgs.x, bg.y, bgs.y, bg.z, bgs.z
-        );
-        let _ = writeln!(
-            s,
-            "accel bias [mGal]:  {:+.1} ± {:.1}, {:+.1} ± {:.1}, {:+.1} ± {:.1}",
-            ba.x, bas.x, ba.y, bas.y, ba.z, bas.z
-        );
-        // Sensor errors only: the attitude's prior is already the coarse stage's
-        // bias-limited result, so its ratio says nothing about observability.
-        let unobservable: Vec<String> = a
-            .observability
-            .iter()
-            .filter(|(n, r)| *r >= schuler::align::OBSERVABLE_RATIO && n.starts_with('b'))
-            .map(|(n, _)| {
-                let axis = n.chars().last().unwrap_or('?');
-                let sensor = if n.starts_with("bg") { "gyro" } else { "accel" };
-                format!("{sensor} bias {axis}")
-            })
-            .collect();
-        let _ = writeln!(
-            s,
-            "not observable at rest (estimates stay at their prior): {}",
-            if unobservable.is_empty() {
-                "none".to_string()
-            } else {
-                unobservable.join(", ")
-            }
-        );
+        let sd = a.attitude_std.map(f64::to_degrees);
+        stage_row(&mut s, "fine", a.t_end, &a.state.euler(), &sd);
+        write_biases(&mut s, a);
     }
     let _ = writeln!(s, "spikes rejected: {}", a.spikes.len());
     for sp in a.spikes.iter().take(5) {
@@ -230,34 +280,7 @@ pub fn summary_text(a: &Alignment, timing: &[(&str, f64)]) -> String {
             sp.t, sp.channel, sp.sigmas
         );
     }
-    let m = &a.motion;
-    if m.angular_motion || m.vibration {
-        let _ = writeln!(
-            s,
-            "motion detected: {}{}; the filter's stillness noise was raised to match",
-            if m.angular_motion {
-                format!(
-                    "angular motion (gyro block scatter {:.2e} rad/s vs noise {:.2e})",
-                    m.gyro_block_scatter.max(),
-                    m.gyro_block_noise.max()
-                )
-            } else {
-                String::new()
-            },
-            if m.vibration {
-                format!(
-                    "{}vibration (accel scatter {:.3} m/s^2 vs noise {:.3})",
-                    if m.angular_motion { ", " } else { "" },
-                    m.accel_sample_scatter.max(),
-                    m.accel_sample_noise.max()
-                )
-            } else {
-                String::new()
-            }
-        );
-    } else {
-        let _ = writeln!(s, "motion: none beyond the sensor noise");
-    }
+    write_motion(&mut s, &a.motion);
     let times: Vec<String> = timing
         .iter()
         .map(|(n, t)| format!("{n} {:.3} s", t))

@@ -37,7 +37,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Nav(args) => schuler_cli::commands::nav::run(args),
+        Command::Nav(args) => schuler_cli::commands::run_nav(args),
         Command::Align(args) => schuler_cli::commands::align::run(args),
         Command::Demo(args) => schuler_cli::commands::demo::run(args),
         Command::Simulate(args) => schuler_cli::commands::simulate::run(args),

@@ -17,9 +17,9 @@ use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
 use schuler::session::{
-    Aid, MechanizationConfig, Session, SessionConfig, SessionError, Start, Summary,
+    Aid, Finished, MechanizationConfig, Session, SessionConfig, SessionError, Start, Summary,
 };
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Everything a run needs besides its aiding, validated.
 #[derive(Debug, Clone)]
@@ -82,20 +82,15 @@ pub struct RunSummary {
     pub heading_settled: Option<(f64, f64)>,
 }
 
-/// Navigate `samples` (the first carries `start`) on `earth` with the settings and,
-/// if given, the aiding; write everything into `settings.out`. On a read error all
-/// that was computed is written before the error is returned.
-pub fn navigate<E: EarthModel, I>(
+/// The session from `start` with the settings' configuration (aided: with the truth
+/// and every aid pushed) and the outputs it writes into `settings.out`: the
+/// navigation result and, aided, the filter's files.
+fn open<E: EarthModel>(
     earth: E,
     settings: &NavSettings,
     aiding: Option<&Aiding>,
     start: Start,
-    samples: I,
-    on_sample: impl FnMut(u64),
-) -> Result<RunSummary>
-where
-    I: Iterator<Item = Result<ImuSample, InputError>>,
-{
+) -> Result<(Session<E>, Outputs)> {
     let out = &settings.out;
     let mut session =
         Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
@@ -111,14 +106,78 @@ where
         }
         None => None,
     };
-    let Some(driven) = drive(
-        session,
-        samples,
-        Outputs::new(writer, files),
+    Ok((session, Outputs::new(writer, files)))
+}
+
+/// The facts of an aided run, with summary `s`, that the report states.
+fn run_facts<'a>(
+    settings: &'a NavSettings,
+    a: &'a Aiding,
+    nav_file: &'a Path,
+    s: &Summary,
+) -> RunFacts<'a> {
+    RunFacts {
+        imu: &settings.imu,
+        nav_file,
+        mechanization: s.first_mechanization,
+        layout: s.layout.unwrap_or_else(Layout::core),
+        samples: s.samples,
+        t_first: s.t_first,
+        t_last: s.t_last,
+        counts: s.counts,
+        gate_resets: s.gate_resets as usize,
+        fixes: &a.fixes,
+    }
+}
+
+/// The end of an aided run: the filter's files closed (`rejected.csv`) and the
+/// smoothed trajectory written, then the read error that stopped the run if any, else
+/// the consistency report; returns the text to print.
+fn finish_aided<E: EarthModel>(
+    earth: &E,
+    settings: &NavSettings,
+    a: &Aiding,
+    files: FilterFiles,
+    finished: &Finished,
+    failure: Option<anyhow::Error>,
+) -> Result<String> {
+    let out = &settings.out;
+    let log = files.finish(out)?;
+    if let Some(smoothed) = &finished.smoothed {
+        write_smoothed(earth, &out.join("smoothed"), settings.week, smoothed)?;
+    }
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let nav_file = out.join(a.names.nav);
+    crate::aided::report::write(
         out,
-        on_sample,
-    )?
-    else {
+        a.report.html,
+        &ReportData {
+            facts: run_facts(settings, a, &nav_file, &finished.summary),
+            innovations: &log.rows,
+            samples: &finished.snapshots,
+            settings: &a.report,
+        },
+    )
+}
+
+/// Navigate `samples` (the first carries `start`) on `earth` with the settings and,
+/// if given, the aiding; write everything into `settings.out`. On a read error all
+/// that was computed is written before the error is returned.
+pub fn navigate<E: EarthModel, I>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+    start: Start,
+    samples: I,
+    on_sample: impl FnMut(u64),
+) -> Result<RunSummary>
+where
+    I: Iterator<Item = Result<ImuSample, InputError>>,
+{
+    let (session, outputs) = open(earth, settings, aiding, start)?;
+    let Some(driven) = drive(session, samples, outputs, &settings.out, on_sample)? else {
         bail!(
             "{}: no IMU sample in the requested time window",
             settings.imu.display()
@@ -131,40 +190,13 @@ where
         filter,
         heading_settled,
     } = driven;
-    let mut report_text = String::new();
-    if let (Some(a), Some(files)) = (aiding, filter) {
-        let log = files.finish(out)?;
-        if let Some(smoothed) = &finished.smoothed {
-            write_smoothed(&earth, &out.join("smoothed"), settings.week, smoothed)?;
-        }
-        if let Some(e) = failure {
-            return Err(e);
-        }
-        let s = &finished.summary;
-        report_text = crate::aided::report::write(
-            out,
-            a.report.html,
-            &ReportData {
-                facts: RunFacts {
-                    imu: &settings.imu,
-                    nav_file: &out.join(a.names.nav),
-                    mechanization: s.first_mechanization,
-                    layout: s.layout.unwrap_or_else(Layout::core),
-                    samples: s.samples,
-                    t_first: s.t_first,
-                    t_last: s.t_last,
-                    counts: s.counts,
-                    gate_resets: s.gate_resets as usize,
-                    fixes: &a.fixes,
-                },
-                innovations: &log.rows,
-                samples: &finished.snapshots,
-                settings: &a.report,
-            },
-        )?;
-    } else if let Some(e) = failure {
-        return Err(e);
-    }
+    let report_text = match (aiding, filter) {
+        (Some(a), Some(files)) => finish_aided(&earth, settings, a, files, &finished, failure)?,
+        _ => match failure {
+            Some(e) => return Err(e),
+            None => String::new(),
+        },
+    };
     Ok(RunSummary {
         nav: finished.summary,
         epochs,

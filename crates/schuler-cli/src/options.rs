@@ -1,12 +1,15 @@
 //! Option types shared by the commands: comma-separated triples, the Earth model,
 //! the IMU file's format and layout, the mechanization, the IMU grade, and quantities
-//! with units; each parsed from flags and TOML alike.
+//! with units; each parsed from flags and TOML alike. Also the textbook commands' flag
+//! values with units and the textbook sphere (`schuler channel`, `schuler vertical`).
 
 use crate::formats::{ImuFormat, ImuLayout};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
+use schuler::earth::Sphere;
 use schuler::filter::ImuNoise;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
+use schuler::units::{self, Dimension};
 use serde::Deserialize;
 
 /// Three comma-separated numbers, e.g. `45.07,7.68,245`.
@@ -161,4 +164,76 @@ pub fn quantity(
         bail!("--{flag} must not be negative, got {s:?}");
     }
     Ok(Some(x))
+}
+
+// ---------------------------------------------------------------------------------------
+// Flag values with units (`schuler channel`, `schuler vertical`).
+
+/// A flag value with a unit of dimension `dim`, in SI.
+fn unit_value(s: &str, dim: Dimension) -> Result<f64, String> {
+    units::parse_as(s, dim).map_err(|e| e.to_string())
+}
+
+/// An acceleration with its unit (`1e-3m/s^2`, `100ug`, `1mGal`) in m/s^2.
+pub(crate) fn acceleration(s: &str) -> Result<f64, String> {
+    unit_value(s, Dimension::Acceleration)
+}
+
+/// An angular rate with its unit (`0.01deg/h`, `6deg/s`) in rad/s.
+pub(crate) fn angular_rate(s: &str) -> Result<f64, String> {
+    unit_value(s, Dimension::AngularRate)
+}
+
+/// An angle with its unit (`20arcsec`, `180deg`) in rad.
+pub(crate) fn angle(s: &str) -> Result<f64, String> {
+    unit_value(s, Dimension::Angle)
+}
+
+/// A velocity with its unit (`1m/s`, `250kn`) in m/s.
+pub(crate) fn velocity(s: &str) -> Result<f64, String> {
+    unit_value(s, Dimension::Velocity)
+}
+
+/// A length with its unit (`100m`, `6371km`) in m.
+pub(crate) fn length(s: &str) -> Result<f64, String> {
+    unit_value(s, Dimension::Length)
+}
+
+/// A time with its unit (`4h`, `0.1s`) in s.
+pub(crate) fn time(s: &str) -> Result<f64, String> {
+    unit_value(s, Dimension::Time)
+}
+
+/// A ratio: a bare number or with `ppm`, `ppb`, `%`.
+pub(crate) fn ratio(s: &str) -> Result<f64, String> {
+    units::parse_as_or_si(s, Dimension::Dimensionless).map_err(|e| e.to_string())
+}
+
+/// True for a number > 0 (false for NaN).
+pub(crate) fn is_positive(x: f64) -> bool {
+    x > 0.0
+}
+
+/// The textbook sphere's radius and surface gravitation (`schuler channel`, `schuler vertical`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct SphereArgs {
+    /// Sphere radius a.
+    #[arg(long, value_parser = length, allow_hyphen_values = true, default_value = "6371km", value_name = "LENGTH")]
+    pub radius: f64,
+    /// Gravitation at the surface g.
+    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, default_value = "9.81m/s^2", value_name = "ACCEL")]
+    pub g: f64,
+}
+
+impl SphereArgs {
+    /// The sphere rotating at `rate`, after checking both values are positive.
+    pub fn sphere(&self, rate: f64) -> Result<Sphere> {
+        if !is_positive(self.radius) {
+            bail!("--radius must be positive, got {} m", self.radius);
+        }
+        if !is_positive(self.g) {
+            bail!("--g must be positive, got {} m/s^2", self.g);
+        }
+        Ok(Sphere::with_surface_gravity(self.radius, self.g, rate))
+    }
 }

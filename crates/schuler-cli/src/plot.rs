@@ -21,6 +21,17 @@ use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
+/// Time axis: hours for runs of 2 h or more, minutes from 10 min, else seconds.
+pub(crate) fn time_axis(duration: f64) -> (f64, &'static str) {
+    if duration >= 7200.0 {
+        (3600.0, "t [h]")
+    } else if duration >= 600.0 {
+        (60.0, "t [min]")
+    } else {
+        (1.0, "t [s]")
+    }
+}
+
 /// How a series is stroked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LineStyle {
@@ -39,6 +50,13 @@ impl LineStyle {
             LineStyle::Dashed => Some("8 5"),
             LineStyle::Dotted => Some("2 4"),
         }
+    }
+
+    /// The SVG attribute ` stroke-dasharray="…"`, empty for a solid line.
+    fn dash_attribute(self) -> String {
+        self.dasharray()
+            .map(|d| format!(r#" stroke-dasharray="{d}""#))
+            .unwrap_or_default()
     }
 }
 
@@ -145,9 +163,197 @@ impl Plot {
 
     /// Renders the plot as a standalone SVG document.
     pub fn to_svg(&self) -> String {
-        let (w, h) = (f64::from(self.width), f64::from(self.height));
-        let (pw, ph) = (w - LEFT - RIGHT, h - TOP - BOTTOM);
-        let finite = self
+        let f = Frame::new(self);
+        let mut s = String::with_capacity(64 * 1024);
+        self.write_head(&mut s, &f);
+        self.write_spans(&mut s, &f);
+        f.write_grid(&mut s);
+        self.write_axes(&mut s, &f);
+        self.write_series(&mut s, &f);
+        self.write_legend(&mut s, &f);
+        s.push_str("</svg>\n");
+        s
+    }
+
+    /// The document's opening tag, the white background and the title.
+    fn write_head(&self, s: &mut String, f: &Frame) {
+        let (w, h) = (f.w, f.h);
+        let _ = writeln!(
+            s,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
+        );
+        let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="24" text-anchor="middle" font-size="15">{}</text>"#,
+            LEFT + f.pw / 2.0,
+            esc(&self.title)
+        );
+    }
+
+    /// The shaded spans, clipped to the plot area.
+    fn write_spans(&self, s: &mut String, f: &Frame) {
+        for span in &self.spans {
+            let (a, b) = (f.sx(span.from.max(f.x0)), f.sx(span.to.min(f.x1)));
+            if b > a {
+                let _ = writeln!(
+                    s,
+                    r##"<rect x="{a:.1}" y="{TOP}" width="{:.1}" height="{}" fill="#999999" fill-opacity="0.18"/>"##,
+                    b - a,
+                    f.ph
+                );
+            }
+        }
+    }
+
+    /// The plot area's frame and the axis labels.
+    fn write_axes(&self, s: &mut String, f: &Frame) {
+        let _ = writeln!(
+            s,
+            r#"<rect x="{LEFT}" y="{TOP}" width="{}" height="{}" fill="none" stroke="black"/>"#,
+            f.pw, f.ph
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+            LEFT + f.pw / 2.0,
+            f.h - 12.0,
+            esc(&self.x_label)
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{}</text>"#,
+            TOP + f.ph / 2.0,
+            TOP + f.ph / 2.0,
+            esc(&self.y_label)
+        );
+    }
+
+    /// Each series, thinned per pixel column: a polyline per run of finite points, a
+    /// dot for a lone point.
+    fn write_series(&self, s: &mut String, f: &Frame) {
+        for (i, series) in self.series.iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            let dash = series.style.dash_attribute();
+            for run in thin(&series.points, f.x0, f.x1, f.pw as usize) {
+                if run.len() == 1 {
+                    let (x, y) = run[0];
+                    let _ = writeln!(
+                        s,
+                        r#"<circle cx="{:.2}" cy="{:.2}" r="1.5" fill="{color}"/>"#,
+                        f.sx(x),
+                        f.sy(y)
+                    );
+                    continue;
+                }
+                let _ = write!(
+                    s,
+                    r#"<polyline fill="none" stroke="{color}" stroke-width="1.6"{dash} points=""#
+                );
+                for (x, y) in run {
+                    let _ = write!(s, "{:.2},{:.2} ", f.sx(x), f.sy(y));
+                }
+                let _ = writeln!(s, r#""/>"#);
+            }
+        }
+    }
+
+    /// The legend's entries: each series' label and stroke, then the shaded spans'
+    /// label (empty stroke).
+    fn legend_entries(&self) -> Vec<(String, String)> {
+        let mut entries: Vec<(String, String)> = self
+            .series
+            .iter()
+            .enumerate()
+            .map(|(i, se)| {
+                let color = PALETTE[i % PALETTE.len()];
+                let dash = se.style.dash_attribute();
+                (
+                    se.label.clone(),
+                    format!(r#"stroke="{color}" stroke-width="2"{dash}"#),
+                )
+            })
+            .collect();
+        if !self.spans.is_empty() && !self.span_label.is_empty() {
+            entries.push((self.span_label.clone(), String::new()));
+        }
+        entries
+    }
+
+    /// The legend, top right inside the frame: a box sized to the longest label, a
+    /// stroke sample (or a shaded swatch) and the label per entry.
+    fn write_legend(&self, s: &mut String, f: &Frame) {
+        let entries = self.legend_entries();
+        if entries.is_empty() {
+            return;
+        }
+        let longest = entries
+            .iter()
+            .map(|e| e.0.chars().count())
+            .max()
+            .unwrap_or(0) as f64;
+        let bw = 40.0 + 7.0 * longest;
+        let bh = 8.0 + 18.0 * entries.len() as f64;
+        let bx = LEFT + f.pw - bw - 8.0;
+        let by = TOP + 8.0;
+        let _ = writeln!(
+            s,
+            r##"<rect x="{bx:.1}" y="{by:.1}" width="{bw:.1}" height="{bh:.1}" fill="white" fill-opacity="0.9" stroke="#888888"/>"##
+        );
+        for (k, (text, stroke)) in entries.iter().enumerate() {
+            let y = by + 16.0 + 18.0 * k as f64;
+            if stroke.is_empty() {
+                let _ = writeln!(
+                    s,
+                    r##"<rect x="{:.1}" y="{:.1}" width="24" height="10" fill="#999999" fill-opacity="0.3"/>"##,
+                    bx + 8.0,
+                    y - 8.0
+                );
+            } else {
+                let _ = writeln!(
+                    s,
+                    r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" {stroke}/>"#,
+                    bx + 8.0,
+                    y - 4.0,
+                    bx + 32.0,
+                    y - 4.0
+                );
+            }
+            let _ = writeln!(
+                s,
+                r#"<text x="{:.1}" y="{y:.1}">{}</text>"#,
+                bx + 38.0,
+                esc(text)
+            );
+        }
+    }
+}
+
+/// The plot area in data and in pixels: the ranges (finite points widened, 5 % in y,
+/// and extended to whole ticks), the ticks, and the map from data to pixels.
+struct Frame {
+    /// Document width and height \[px\].
+    w: f64,
+    h: f64,
+    /// Plot-area width and height \[px\].
+    pw: f64,
+    ph: f64,
+    /// X range (data units).
+    x0: f64,
+    x1: f64,
+    /// Y range (data units).
+    y0: f64,
+    y1: f64,
+    /// Tick values.
+    xt: Vec<f64>,
+    yt: Vec<f64>,
+}
+
+impl Frame {
+    /// The frame of `plot`'s size around its finite points.
+    fn new(plot: &Plot) -> Self {
+        let (w, h) = (f64::from(plot.width), f64::from(plot.height));
+        let finite = plot
             .series
             .iter()
             .flat_map(|s| s.points.iter())
@@ -168,167 +374,54 @@ impl Plot {
         let (y0, y1) = widen(y0, y1, 0.05);
         let xt = ticks(x0, x1, 8);
         let yt = ticks(y0, y1, 7);
-        let (x0, x1) = (x0.min(xt[0]), x1.max(*xt.last().unwrap_or(&x1)));
-        let (y0, y1) = (y0.min(yt[0]), y1.max(*yt.last().unwrap_or(&y1)));
-        let sx = |x: f64| LEFT + (x - x0) / (x1 - x0) * pw;
-        let sy = |y: f64| TOP + (y1 - y) / (y1 - y0) * ph;
-
-        let mut s = String::with_capacity(64 * 1024);
-        let _ = writeln!(
-            s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
-        );
-        let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="24" text-anchor="middle" font-size="15">{}</text>"#,
-            LEFT + pw / 2.0,
-            esc(&self.title)
-        );
-        // Shaded spans, clipped to the plot area.
-        for span in &self.spans {
-            let (a, b) = (sx(span.from.max(x0)), sx(span.to.min(x1)));
-            if b > a {
-                let _ = writeln!(
-                    s,
-                    r##"<rect x="{a:.1}" y="{TOP}" width="{:.1}" height="{ph}" fill="#999999" fill-opacity="0.18"/>"##,
-                    b - a
-                );
-            }
+        Self {
+            w,
+            h,
+            pw: w - LEFT - RIGHT,
+            ph: h - TOP - BOTTOM,
+            x0: x0.min(xt[0]),
+            x1: x1.max(*xt.last().unwrap_or(&x1)),
+            y0: y0.min(yt[0]),
+            y1: y1.max(*yt.last().unwrap_or(&y1)),
+            xt,
+            yt,
         }
-        // Grid and tick labels.
-        for &v in &xt {
-            let x = sx(v);
+    }
+
+    /// Pixel column of `x`.
+    fn sx(&self, x: f64) -> f64 {
+        LEFT + (x - self.x0) / (self.x1 - self.x0) * self.pw
+    }
+
+    /// Pixel row of `y` (up is smaller).
+    fn sy(&self, y: f64) -> f64 {
+        TOP + (self.y1 - y) / (self.y1 - self.y0) * self.ph
+    }
+
+    /// The grid lines and tick labels of both axes.
+    fn write_grid(&self, s: &mut String) {
+        let (pw, ph) = (self.pw, self.ph);
+        for &v in &self.xt {
+            let x = self.sx(v);
             let _ = writeln!(
                 s,
                 r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{}" stroke="#e0e0e0"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
                 TOP + ph,
                 TOP + ph + 16.0,
-                label(v, &xt)
+                label(v, &self.xt)
             );
         }
-        for &v in &yt {
-            let y = sy(v);
+        for &v in &self.yt {
+            let y = self.sy(v);
             let _ = writeln!(
                 s,
                 r##"<line x1="{LEFT}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#e0e0e0"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
                 LEFT + pw,
                 LEFT - 6.0,
                 y + 4.0,
-                label(v, &yt)
+                label(v, &self.yt)
             );
         }
-        let _ = writeln!(
-            s,
-            r#"<rect x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-            LEFT + pw / 2.0,
-            h - 12.0,
-            esc(&self.x_label)
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{}</text>"#,
-            TOP + ph / 2.0,
-            TOP + ph / 2.0,
-            esc(&self.y_label)
-        );
-        // Series.
-        for (i, series) in self.series.iter().enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
-            let dash = series
-                .style
-                .dasharray()
-                .map(|d| format!(r#" stroke-dasharray="{d}""#))
-                .unwrap_or_default();
-            for run in thin(&series.points, x0, x1, pw as usize) {
-                if run.len() == 1 {
-                    let (x, y) = run[0];
-                    let _ = writeln!(
-                        s,
-                        r#"<circle cx="{:.2}" cy="{:.2}" r="1.5" fill="{color}"/>"#,
-                        sx(x),
-                        sy(y)
-                    );
-                    continue;
-                }
-                let _ = write!(
-                    s,
-                    r#"<polyline fill="none" stroke="{color}" stroke-width="1.6"{dash} points=""#
-                );
-                for (x, y) in run {
-                    let _ = write!(s, "{:.2},{:.2} ", sx(x), sy(y));
-                }
-                let _ = writeln!(s, r#""/>"#);
-            }
-        }
-        // Legend, top right inside the frame.
-        let mut entries: Vec<(String, String)> = self
-            .series
-            .iter()
-            .enumerate()
-            .map(|(i, se)| {
-                let color = PALETTE[i % PALETTE.len()];
-                let dash = se
-                    .style
-                    .dasharray()
-                    .map(|d| format!(r#" stroke-dasharray="{d}""#))
-                    .unwrap_or_default();
-                (
-                    se.label.clone(),
-                    format!(r#"stroke="{color}" stroke-width="2"{dash}"#),
-                )
-            })
-            .collect();
-        if !self.spans.is_empty() && !self.span_label.is_empty() {
-            entries.push((self.span_label.clone(), String::new()));
-        }
-        if !entries.is_empty() {
-            let longest = entries
-                .iter()
-                .map(|e| e.0.chars().count())
-                .max()
-                .unwrap_or(0) as f64;
-            let bw = 40.0 + 7.0 * longest;
-            let bh = 8.0 + 18.0 * entries.len() as f64;
-            let bx = LEFT + pw - bw - 8.0;
-            let by = TOP + 8.0;
-            let _ = writeln!(
-                s,
-                r##"<rect x="{bx:.1}" y="{by:.1}" width="{bw:.1}" height="{bh:.1}" fill="white" fill-opacity="0.9" stroke="#888888"/>"##
-            );
-            for (k, (text, stroke)) in entries.iter().enumerate() {
-                let y = by + 16.0 + 18.0 * k as f64;
-                if stroke.is_empty() {
-                    let _ = writeln!(
-                        s,
-                        r##"<rect x="{:.1}" y="{:.1}" width="24" height="10" fill="#999999" fill-opacity="0.3"/>"##,
-                        bx + 8.0,
-                        y - 8.0
-                    );
-                } else {
-                    let _ = writeln!(
-                        s,
-                        r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" {stroke}/>"#,
-                        bx + 8.0,
-                        y - 4.0,
-                        bx + 32.0,
-                        y - 4.0
-                    );
-                }
-                let _ = writeln!(
-                    s,
-                    r#"<text x="{:.1}" y="{y:.1}">{}</text>"#,
-                    bx + 38.0,
-                    esc(text)
-                );
-            }
-        }
-        s.push_str("</svg>\n");
-        s
     }
 }
 

@@ -154,26 +154,67 @@ fn truth_against_itself_is_zero() {
 #[test]
 fn injected_offsets_come_out_exactly() {
     let lines = truth_lines();
-    let mut csv = vec![
-        "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,extra"
-            .to_owned(),
-    ];
-    let mut expected_north = Vec::new();
-    let mut expected_v_att = Vec::new();
-    let mut wrapped = 0;
-    for l in &lines {
+    let copy = offset_copy(&lines);
+    // 26 rows of the drive (its circle) have yaw in [359.5, 360).
+    assert!(
+        copy.wrapped >= 20,
+        "the copy must cross 0/360 deg: {} rows",
+        copy.wrapped
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let truth = write_lines(dir.path(), "truth.nav", &lines);
+    let nav = write_lines(dir.path(), "nav.csv", &copy.csv);
+    let out = dir.path().join("offset");
+    compare(&nav, &truth, &out, &[]).success();
+    let j = json(&out);
+    assert_eq!(j["nav"]["format"], "csv");
+    assert_eq!(j["epochs"]["exact"], 53000);
+    let rows = errors_csv(&out);
+    assert_eq!(rows.len(), 53000);
+    for ((row, north), dv_att) in rows.iter().zip(&copy.north).zip(&copy.v_att) {
+        assert_offset_row(row, *north, dv_att);
+    }
+    assert_offset_statistics(&j, &copy);
+}
+
+/// The truth's copy with the offsets of [`injected_offsets_come_out_exactly`], and the
+/// errors expected of it.
+struct OffsetCopy {
+    /// The copy as `nav.csv` lines, header first (with an extra column).
+    csv: Vec<String>,
+    /// Expected north error per epoch [m].
+    north: Vec<f64>,
+    /// Expected velocity [m/s] and attitude [deg] errors per epoch.
+    v_att: Vec<[Vector3<f64>; 2]>,
+    /// Rows whose yaw + 0.5 deg wrapped past 360 deg.
+    wrapped: usize,
+}
+
+/// The copy of the truth `lines` 1e-5 deg north, 0.25 m up and 0.5 deg to the right,
+/// with the errors expected from the WGS84 definition and nalgebra's rotations.
+fn offset_copy(lines: &[String]) -> OffsetCopy {
+    let mut copy = OffsetCopy {
+        csv: vec![
+            "t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,extra"
+                .to_owned(),
+        ],
+        north: Vec::new(),
+        v_att: Vec::new(),
+        wrapped: 0,
+    };
+    for l in lines {
         let r: Vec<f64> = l
             .split_whitespace()
             .map(|x| x.parse().expect("n"))
             .collect();
         let yaw = r[10] + 0.5;
         let yaw = if yaw >= 360.0 {
-            wrapped += 1;
+            copy.wrapped += 1;
             yaw - 360.0
         } else {
             yaw
         };
-        csv.push(format!(
+        copy.csv.push(format!(
             "{},{},{},{},{},{},{},{},{},{},7",
             r[1],
             r[2] + 1e-5,
@@ -186,74 +227,73 @@ fn injected_offsets_come_out_exactly() {
             r[9],
             yaw
         ));
-        expected_north.push(wgs84_north_offset(r[2], r[4], r[2] + 1e-5, r[4] + 0.25));
-        let c_nt =
-            Rotation3::from_axis_angle(&Vector3::y_axis(), -(r[2] + 1e-5 - r[2]).to_radians());
-        let v = Vector3::new(r[5], r[6], r[7]);
-        let rad = |x: f64| x.to_radians();
-        let (roll, pitch, yaw_nav) =
-            (c_nt * Rotation3::from_euler_angles(rad(r[8]), rad(r[9]), rad(yaw))).euler_angles();
-        let wrap = |x: f64| (x + 180.0).rem_euclid(360.0) - 180.0;
-        expected_v_att.push([
-            c_nt * v - v,
-            Vector3::new(
-                wrap(roll.to_degrees() - r[8]),
-                wrap(pitch.to_degrees() - r[9]),
-                wrap(yaw_nav.to_degrees() - r[10]),
-            ),
-        ]);
+        copy.north
+            .push(wgs84_north_offset(r[2], r[4], r[2] + 1e-5, r[4] + 0.25));
+        copy.v_att.push(expected_v_att(&r, yaw));
     }
-    // 26 rows of the drive (its circle) have yaw in [359.5, 360).
+    copy
+}
+
+/// Velocity and attitude errors of a truth row `r` (KF-GINS columns) moved 1e-5 deg
+/// north with yaw `yaw`: `C_nt = R_y(−δ)` turns the velocity and the attitude.
+fn expected_v_att(r: &[f64], yaw: f64) -> [Vector3<f64>; 2] {
+    let c_nt = Rotation3::from_axis_angle(&Vector3::y_axis(), -(r[2] + 1e-5 - r[2]).to_radians());
+    let v = Vector3::new(r[5], r[6], r[7]);
+    let rad = |x: f64| x.to_radians();
+    let (roll, pitch, yaw_nav) =
+        (c_nt * Rotation3::from_euler_angles(rad(r[8]), rad(r[9]), rad(yaw))).euler_angles();
+    let wrap = |x: f64| (x + 180.0).rem_euclid(360.0) - 180.0;
+    [
+        c_nt * v - v,
+        Vector3::new(
+            wrap(roll.to_degrees() - r[8]),
+            wrap(pitch.to_degrees() - r[9]),
+            wrap(yaw_nav.to_degrees() - r[10]),
+        ),
+    ]
+}
+
+/// One row of `errors.csv` against the expected north error and velocity and
+/// attitude errors (tolerances: see [`injected_offsets_come_out_exactly`]).
+fn assert_offset_row(row: &[f64], north: f64, [dv, att]: &[Vector3<f64>; 2]) {
     assert!(
-        wrapped >= 20,
-        "the copy must cross 0/360 deg: {wrapped} rows"
+        (row[1] - north).abs() < 1e-8,
+        "t {}: north {} vs {north}",
+        row[0],
+        row[1]
     );
-    let dir = tempfile::tempdir().expect("tempdir");
-    let truth = write_lines(dir.path(), "truth.nav", &lines);
-    let nav = write_lines(dir.path(), "nav.csv", &csv);
-    let out = dir.path().join("offset");
-    compare(&nav, &truth, &out, &[]).success();
-    let j = json(&out);
-    assert_eq!(j["nav"]["format"], "csv");
-    assert_eq!(j["epochs"]["exact"], 53000);
-    let rows = errors_csv(&out);
-    assert_eq!(rows.len(), 53000);
-    for ((row, north), [dv, att]) in rows.iter().zip(&expected_north).zip(&expected_v_att) {
-        assert!(
-            (row[1] - north).abs() < 1e-8,
-            "t {}: north {} vs {north}",
-            row[0],
-            row[1]
-        );
-        assert!(row[2].abs() < 1e-8, "east {}", row[2]);
-        assert!((row[3] + 0.25).abs() < 1e-12, "down {}", row[3]);
-        assert!((row[4] - north).abs() < 1e-8, "horizontal");
-        assert!(
-            (Vector3::new(row[5], row[6], row[7]) - dv).norm() < 1e-12,
-            "t {}: velocity {row:?} vs {dv}",
-            row[0]
-        );
-        assert!(
-            (Vector3::new(row[8], row[9], row[10]) - att).abs().max() < 1e-10,
-            "t {}: attitude {row:?} vs {att}",
-            row[0]
-        );
-        assert!(
-            (row[10] - 0.5).abs() < 1e-6,
-            "t {}: yaw {}",
-            row[0],
-            row[10]
-        );
-        assert_eq!(row[11], 0.0);
-    }
-    // The table agrees with the rows: RMS and max of a near-constant north error.
-    let max_north = expected_north.iter().fold(0.0f64, |m, x| m.max(*x));
-    assert!((stat(&j, "north_m", "max") - max_north).abs() < 1e-8);
-    let yaw_mean = expected_v_att.iter().map(|[_, a]| a.z).sum::<f64>() / 53000.0;
-    assert!((stat(&j, "yaw_deg", "mean") - yaw_mean).abs() < 1e-10);
-    assert!((stat(&j, "yaw_deg", "p95") - 0.5).abs() < 1e-6);
-    assert!((stat(&j, "vertical_m", "mean") + 0.25).abs() < 1e-12);
-    let h3 = stat(&j, "3_d_m", "max");
+    assert!(row[2].abs() < 1e-8, "east {}", row[2]);
+    assert!((row[3] + 0.25).abs() < 1e-12, "down {}", row[3]);
+    assert!((row[4] - north).abs() < 1e-8, "horizontal");
+    assert!(
+        (Vector3::new(row[5], row[6], row[7]) - dv).norm() < 1e-12,
+        "t {}: velocity {row:?} vs {dv}",
+        row[0]
+    );
+    assert!(
+        (Vector3::new(row[8], row[9], row[10]) - att).abs().max() < 1e-10,
+        "t {}: attitude {row:?} vs {att}",
+        row[0]
+    );
+    assert!(
+        (row[10] - 0.5).abs() < 1e-6,
+        "t {}: yaw {}",
+        row[0],
+        row[10]
+    );
+    assert_eq!(row[11], 0.0);
+}
+
+/// The table of `compare.json` agrees with the rows: RMS and max of a near-constant
+/// north error, the yaw's mean and 95 %, the vertical mean and the 3-D maximum.
+fn assert_offset_statistics(j: &Value, copy: &OffsetCopy) {
+    let max_north = copy.north.iter().fold(0.0f64, |m, x| m.max(*x));
+    assert!((stat(j, "north_m", "max") - max_north).abs() < 1e-8);
+    let yaw_mean = copy.v_att.iter().map(|[_, a]| a.z).sum::<f64>() / 53000.0;
+    assert!((stat(j, "yaw_deg", "mean") - yaw_mean).abs() < 1e-10);
+    assert!((stat(j, "yaw_deg", "p95") - 0.5).abs() < 1e-6);
+    assert!((stat(j, "vertical_m", "mean") + 0.25).abs() < 1e-12);
+    let h3 = stat(j, "3_d_m", "max");
     assert!(
         (h3 - (max_north.powi(2) + 0.0625).sqrt()).abs() < 1e-6,
         "{h3}"

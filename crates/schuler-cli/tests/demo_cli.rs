@@ -94,13 +94,9 @@ impl ErrorsCsv {
     }
 }
 
-#[test]
-fn quick_demo_report_is_complete_and_agrees_with_its_data() {
-    let dir = tempfile::tempdir().expect("tmp");
-    let out = dir.path().join("demo");
-    let stdout = run_demo(&out);
-    assert!(stdout.contains("report.html"), "{stdout}");
-    let html = read(&out.join("report.html"));
+/// Every section is in the report and in its contents, and every embedded plot has an
+/// x and a y label with a unit in brackets.
+fn assert_sections_and_plot_units(html: &str) {
     for s in SECTIONS {
         assert!(
             html.contains(&format!("<section id=\"{s}\">")),
@@ -111,7 +107,6 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
             "contents entry {s}"
         );
     }
-    // Every plot is embedded, and each has an x and a y label with a unit in brackets.
     let svgs: Vec<&str> = html.split("<svg").skip(1).collect();
     assert!(svgs.len() >= 10, "{} plots", svgs.len());
     for svg in &svgs {
@@ -126,13 +121,16 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
             .count();
         assert!(labelled >= 2, "a plot lacks axis units");
     }
+}
 
-    let sortie = Sortie::quick().expect("quick sortie");
+/// The sortie's summary: GNSS aiding beats free inertial navigation, the smoother does
+/// no worse than the forward filter, and each row's numbers are its errors CSV's and
+/// the report table's.
+fn assert_sortie_summary(out: &Path, html: &str, sortie: &Sortie) {
     let summary = rows(&out.join("summary.csv"));
     assert_eq!(summary.len(), 5);
     let by_mode = |label: &str| row_of(&summary, label);
-    // Column 4: max dS in flight. GNSS aiding beats free inertial navigation, and the
-    // smoother does no worse than the forward filter.
+    // Column 4: max dS in flight.
     let free = num(&by_mode("inertial with baro loop")[4]);
     let coarse = num(&by_mode("inertial after coarse alignment only")[4]);
     let forward = num(&by_mode("inertial-satellite forward")[4]);
@@ -142,7 +140,6 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
         "{forward} vs {free}, {coarse}"
     );
     assert!(smoothed <= forward, "{smoothed} vs {forward}");
-
     for row in &summary {
         let errors = ErrorsCsv(rows(&out.join(&row[8])));
         let last = errors.0.last().expect("rows");
@@ -169,11 +166,13 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
         );
         assert_eq!(row[6], last[7], "{} yaw", row[0]);
         // The report's table shows the same strings, in order.
-        in_table_in_order(&html, "<section id=\"summary\">", row);
+        in_table_in_order(html, "<section id=\"summary\">", row);
     }
+}
 
-    // Across the pole: the crossing's own table, equal to its CSVs and the report's.
-    let crossing = Crossing::quick(&sortie).expect("quick crossing");
+/// The crossing's own table (`polar_summary.csv`), each row equal to its errors CSV
+/// and to the report's table; returns its rows.
+fn assert_polar_summary(out: &Path, html: &str, crossing: &Crossing) -> Vec<Vec<String>> {
     let polar = rows(&out.join("polar_summary.csv"));
     assert_eq!(polar.len(), 4);
     for row in &polar {
@@ -195,17 +194,22 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
         assert_eq!(row[4], last[3], "{} end", row[0]);
         assert_eq!(row[5], errors.max_from(crossing.t0, 3), "{} max dS", row[0]);
         assert_eq!(row[6], errors.max_from(crossing.t0, 4), "{} max dh", row[0]);
-        in_table_in_order(&html, "<section id=\"polar\">", row);
+        in_table_in_order(html, "<section id=\"polar\">", row);
     }
-    // The truth passes over the pole itself: its epoch at t_pole is on the axis (the
-    // track's x, y in km, 4 decimals: within 0.1 m).
+    polar
+}
+
+/// The truth passes over the pole itself, and GNSS aiding beats free inertial
+/// navigation across it with its error bounded (see the bound's derivation inside).
+fn assert_pole_crossing(out: &Path, polar: &[Vec<String>], crossing: &Crossing) {
+    // The truth's epoch at t_pole is on the axis (the track's x, y in km, 4 decimals:
+    // within 0.1 m).
     let track = rows(&out.join("polar_track.csv"));
     let over = track
         .iter()
         .find(|r| num(&r[0]) == crossing.t_pole())
         .expect("epoch at the pole");
     assert!(num(&over[1]).hypot(num(&over[2])) <= 1e-4, "{over:?}");
-    // GNSS aiding beats free inertial navigation across the pole, and stays bounded.
     // Outside the outage a filter is at least as good as one fix: 3 sigma of a fix's
     // horizontal error, 3 sqrt(1.5^2 + 1.5^2) = 6.4 m. At the outage's end it has
     // drifted for 60 s from there: at most a fix's 3-sigma horizontal velocity error,
@@ -213,7 +217,7 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     // 1 arcmin level uncertainty theta (the filter only improves on it) and an
     // unestimated 50 ug navigation-grade accelerometer bias b: 6.0 m; 25.1 m in all,
     // held for 5 s after the outage while the first fixes pull the drift back.
-    let by_label = |label: &str| row_of(&polar, label);
+    let by_label = |label: &str| row_of(polar, label);
     let free = num(&by_label("wander inertial with baro loop")[5]);
     let aided = by_label("wander inertial-satellite forward");
     let smoothed = num(&by_label("wander inertial-satellite smoothed")[5]);
@@ -232,11 +236,12 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
         };
         assert!(ds < bound, "dS {ds} m at {t} s above {bound} m");
     }
+}
 
-    // Same seed, same data: a second run writes the same bytes (run times aside).
-    let again = dir.path().join("again");
-    run_demo(&again);
-    for f in std::fs::read_dir(&out).expect("dir") {
+/// Same seed, same data: the data files of `out` and `again` are the same bytes (run
+/// times aside).
+fn assert_same_data(out: &Path, again: &Path) {
+    for f in std::fs::read_dir(out).expect("dir") {
         let name = f.expect("entry").file_name();
         let name = name.to_string_lossy();
         let data = name.starts_with("errors_")
@@ -251,4 +256,22 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
             );
         }
     }
+}
+
+#[test]
+fn quick_demo_report_is_complete_and_agrees_with_its_data() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = dir.path().join("demo");
+    let stdout = run_demo(&out);
+    assert!(stdout.contains("report.html"), "{stdout}");
+    let html = read(&out.join("report.html"));
+    assert_sections_and_plot_units(&html);
+    let sortie = Sortie::quick().expect("quick sortie");
+    assert_sortie_summary(&out, &html, &sortie);
+    let crossing = Crossing::quick(&sortie).expect("quick crossing");
+    let polar = assert_polar_summary(&out, &html, &crossing);
+    assert_pole_crossing(&out, &polar, &crossing);
+    let again = dir.path().join("again");
+    run_demo(&again);
+    assert_same_data(&out, &again);
 }

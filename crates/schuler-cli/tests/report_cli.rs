@@ -68,24 +68,9 @@ fn check_test(t: &Value, dof: u64, quantiles: (f64, f64)) -> (u64, f64) {
     (n, mean)
 }
 
-#[test]
-fn aided_run_writes_a_consistent_report() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let sim = common::simulate_drive(dir.path());
-    let out = dir.path().join("out");
-    let truth = sim.join("truth.nav");
-    let run = nav(&sim, &out, &["--truth".as_ref(), truth.as_os_str()]).success();
-    let stdout = String::from_utf8_lossy(&run.get_output().stdout).into_owned();
-    println!("{stdout}");
-    assert!(
-        stdout.contains("NIS  gnss_position  3 dof: mean"),
-        "{stdout}"
-    );
-    assert!(stdout.contains("NEES attitude"), "{stdout}");
-    assert!(stdout.contains("report.html"), "{stdout}");
-
-    // innovations.csv: one row per measurement tested; GNSS rows have 3 components,
-    // baro rows 1 (the others empty).
+/// `innovations.csv`: one row per measurement tested, GNSS rows with 3 components,
+/// baro rows with 1 (the others empty); returns the counts of GNSS and baro rows.
+fn count_innovations(out: &Path) -> (u64, u64) {
     let innovations = std::fs::read_to_string(out.join("innovations.csv")).expect("csv");
     let mut lines = innovations.lines();
     assert_eq!(
@@ -108,9 +93,12 @@ fn aided_run_writes_a_consistent_report() {
             other => panic!("unexpected kind {other}"),
         }
     }
+    (gnss, baro)
+}
 
-    // consistency.json: NIS per kind over the accepted measurements; NEES once a
-    // second against the truth.
+/// `consistency.json`: NIS per kind over the accepted measurements (of the `gnss` and
+/// `baro` tested), each mean inside its interval; NEES once a second against the truth.
+fn assert_consistency(out: &Path, (gnss, baro): (u64, u64)) {
     let j: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("consistency.json")).expect("json"))
             .expect("parse");
@@ -137,9 +125,10 @@ fn aided_run_writes_a_consistent_report() {
         let (epochs, _) = check_test(&j["nees"][block], 3, CHI2_3);
         assert_eq!(epochs, 1100, "{block}");
     }
+}
 
-    // report.html: every section, in the contents and in the body.
-    let html = std::fs::read_to_string(out.join("report.html")).expect("html");
+/// `report.html`: every section, in the contents and in the body.
+fn assert_sections(html: &str) {
     for id in [
         "measurements",
         "position",
@@ -158,7 +147,12 @@ fn aided_run_writes_a_consistent_report() {
             "no section {id}"
         );
     }
-    // Every plot has both axis labels with a unit in brackets, and its files exist.
+}
+
+/// Every plot of `report.html` has both axis labels with a unit in brackets and its
+/// files exist in `out`; there is one figure per SVG in `report/`, as many as the
+/// drive's run plots.
+fn assert_figures(out: &Path, html: &str) {
     let mut figures = 0;
     for fig in html.split("<figure ").skip(1) {
         figures += 1;
@@ -189,8 +183,11 @@ fn aided_run_writes_a_consistent_report() {
     // 2 NIS, 3 NEES.
     assert_eq!(svgs, 1 + 7 + 4 + 2 + 3);
     assert_eq!(figures, svgs);
-    // Opens offline: no script, stylesheet link, image source or URL but the SVG
-    // namespace.
+}
+
+/// `report.html` opens offline: no script, stylesheet link, image source or URL but
+/// the SVG namespace.
+fn assert_self_contained(html: &str) {
     for external in ["<script", "<link", " src=", "url(", "@import", "https://"] {
         assert!(!html.contains(external), "{external}");
     }
@@ -198,16 +195,18 @@ fn aided_run_writes_a_consistent_report() {
         html.matches("http://").count(),
         html.matches("xmlns=\"http://www.w3.org/2000/svg\"").count()
     );
+}
 
-    // The statistics are `schuler compare`'s: the same CEP for the same files.
-    let cmp = dir.path().join("compare");
+/// The report's statistics are `schuler compare`'s: the same CEP for `nav` against
+/// `truth` (compared into `cmp`).
+fn assert_cep_as_compare(html: &str, nav: &Path, truth: &Path, cmp: &Path) {
     assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .arg("compare")
-        .arg(out.join("nav.txt"))
-        .arg(&truth)
+        .arg(nav)
+        .arg(truth)
         .arg("--out")
-        .arg(&cmp)
+        .arg(cmp)
         .assert()
         .success();
     let c: Value =
@@ -215,6 +214,31 @@ fn aided_run_writes_a_consistent_report() {
             .expect("parse");
     let cep = c["statistics"]["cep_m"].as_f64().expect("cep");
     assert!(html.contains(&format!("CEP {cep:.4} m")), "CEP {cep}");
+}
+
+#[test]
+fn aided_run_writes_a_consistent_report() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sim = common::simulate_drive(dir.path());
+    let out = dir.path().join("out");
+    let truth = sim.join("truth.nav");
+    let run = nav(&sim, &out, &["--truth".as_ref(), truth.as_os_str()]).success();
+    let stdout = String::from_utf8_lossy(&run.get_output().stdout).into_owned();
+    println!("{stdout}");
+    assert!(
+        stdout.contains("NIS  gnss_position  3 dof: mean"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("NEES attitude"), "{stdout}");
+    assert!(stdout.contains("report.html"), "{stdout}");
+    let tested = count_innovations(&out);
+    assert_consistency(&out, tested);
+    let html = std::fs::read_to_string(out.join("report.html")).expect("html");
+    assert_sections(&html);
+    assert_figures(&out, &html);
+    assert_self_contained(&html);
+    let cmp = dir.path().join("compare");
+    assert_cep_as_compare(&html, &out.join("nav.txt"), &truth, &cmp);
 }
 
 #[test]

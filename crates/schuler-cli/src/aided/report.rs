@@ -481,32 +481,25 @@ fn build(
 /// One column of `sensor_errors.csv`.
 type Column = Box<dyn Fn(&ReportSample) -> f64>;
 
-fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
-    let data = c.data;
-    let s = r.section("position", "Position error against the truth");
-    let Some((truth_path, truth)) = &data.settings.truth else {
-        s.paragraph("No truth given (--truth FILE, KF-GINS navigation text or nav.csv).");
-        return Ok(());
-    };
-    let (_, nav) = crate::formats::nav::read_nav(data.facts.nav_file)?;
-    let cmp: Comparison = compare(&nav, truth, None, None, &c.gaps).with_context(|| {
-        format!(
-            "comparing {} with {}",
-            data.facts.nav_file.display(),
-            truth_path.display()
-        )
-    })?;
-    s.paragraph(&format!(
+/// The position section's opening: how many epochs were compared, and how the errors
+/// and statistics are defined.
+fn comparison_text(c: &Ctx, cmp: &Comparison, truth_path: &Path) -> String {
+    format!(
         "{} epochs of {} against {} ({} exact, {} with the truth interpolated). \
          Horizontal is the seed's circular error dS = sqrt(dN² + dE²); vertical dD is \
          positive down. Statistics as `schuler compare` gives them: 95 % is the \
          nearest-rank percentile of |e|, CEP the median of dS.",
         cmp.matching.matched(),
-        data.facts.nav_file.display(),
+        c.data.facts.nav_file.display(),
         truth_path.display(),
         cmp.matching.exact,
         cmp.matching.interpolated
-    ));
+    )
+}
+
+/// RMS, largest, 95 % and mean of each error quantity over the run, with CEP and
+/// CEP95 in the caption.
+fn error_table(c: &Ctx, cmp: &Comparison) -> Table {
     let mut table = Table::new([
         "error",
         "unit",
@@ -527,48 +520,83 @@ fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
             format!("{:.4}", sm.mean),
         ]);
     }
-    s.table(table.caption(&format!(
+    table.caption(&format!(
         "Errors over the run; CEP {:.4} m, CEP95 {:.4} m",
         cmp.stats.cep, cmp.stats.cep95
-    )));
+    ))
+}
+
+/// The largest errors inside each GNSS gap that has compared epochs (INS bridging)
+/// and the RMS of those maxima; `None` without such a gap.
+fn gap_table(c: &Ctx, cmp: &Comparison) -> Option<Table> {
     let with: Vec<_> = cmp.stats.outages.iter().filter(|o| o.epochs > 0).collect();
-    if !with.is_empty() {
-        let mut t = Table::new([
-            "GNSS gap, t − t0 [s]",
-            "epochs",
-            "max dS [m]",
-            "max |dD| [m]",
-            "max |yaw| [deg]",
-        ]);
-        for o in &with {
-            t = t.row([
-                format!("{:.1}–{:.1}", c.rel(o.from_sow), c.rel(o.to_sow)),
-                o.epochs.to_string(),
-                format!("{:.3}", o.horizontal),
-                format!("{:.3}", o.vertical),
-                format!("{:.4}", o.att.yaw.to_degrees()),
-            ]);
-        }
-        if let Some(rms) = &cmp.stats.outage_rms {
-            t = t.row([
-                "RMS of the maxima".to_owned(),
-                rms.epochs.to_string(),
-                format!("{:.3}", rms.horizontal),
-                format!("{:.3}", rms.vertical),
-                format!("{:.4}", rms.att.yaw.to_degrees()),
-            ]);
-        }
-        s.table(t.caption("Largest errors inside each GNSS gap (INS bridging)"));
+    if with.is_empty() {
+        return None;
     }
-    crate::output::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
+    let mut t = Table::new([
+        "GNSS gap, t − t0 [s]",
+        "epochs",
+        "max dS [m]",
+        "max |dD| [m]",
+        "max |yaw| [deg]",
+    ]);
+    for o in &with {
+        t = t.row([
+            format!("{:.1}–{:.1}", c.rel(o.from_sow), c.rel(o.to_sow)),
+            o.epochs.to_string(),
+            format!("{:.3}", o.horizontal),
+            format!("{:.3}", o.vertical),
+            format!("{:.4}", o.att.yaw.to_degrees()),
+        ]);
+    }
+    if let Some(rms) = &cmp.stats.outage_rms {
+        t = t.row([
+            "RMS of the maxima".to_owned(),
+            rms.epochs.to_string(),
+            format!("{:.3}", rms.horizontal),
+            format!("{:.3}", rms.vertical),
+            format!("{:.4}", rms.att.yaw.to_degrees()),
+        ]);
+    }
+    Some(t.caption("Largest errors inside each GNSS gap (INS bridging)"))
+}
+
+/// The circular error dS and the vertical error dD against time, gaps shaded.
+fn position_plot(c: &Ctx, cmp: &Comparison) -> Plot {
     let t: Vec<f64> = cmp.errors.iter().map(|e| c.rel(e.t_sow)).collect();
     let ds: Vec<f64> = cmp.errors.iter().map(|e| e.horizontal()).collect();
     let dd: Vec<f64> = cmp.errors.iter().map(|e| e.pos_n.z).collect();
-    let plot = c.shade(
+    c.shade(
         Plot::new("Position error against the truth", T_LABEL, "error [m]")
             .line("circular error dS (horizontal)", &t, &ds, LineStyle::Solid)
             .line("vertical dD (down)", &t, &dd, LineStyle::Dashed),
-    );
+    )
+}
+
+/// The navigation result against the truth (`--truth`): statistics, the errors in
+/// the GNSS gaps, `errors.csv` and the plot; a note without a truth.
+fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
+    let data = c.data;
+    let s = r.section("position", "Position error against the truth");
+    let Some((truth_path, truth)) = &data.settings.truth else {
+        s.paragraph("No truth given (--truth FILE, KF-GINS navigation text or nav.csv).");
+        return Ok(());
+    };
+    let (_, nav) = crate::formats::nav::read_nav(data.facts.nav_file)?;
+    let cmp: Comparison = compare(&nav, truth, None, None, &c.gaps).with_context(|| {
+        format!(
+            "comparing {} with {}",
+            data.facts.nav_file.display(),
+            truth_path.display()
+        )
+    })?;
+    s.paragraph(&comparison_text(c, &cmp, truth_path));
+    s.table(error_table(c, &cmp));
+    if let Some(t) = gap_table(c, &cmp) {
+        s.table(t);
+    }
+    crate::output::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
+    let plot = position_plot(c, &cmp);
     let svg = c.svg("position_error", &plot)?;
     s.plot_with_files(&plot, &[&svg, "report/errors.csv"]);
     Ok(())
@@ -624,9 +652,153 @@ fn sensor_block(e: &SensorEstimates, block: usize) -> nalgebra::Vector3<f64> {
     }
 }
 
+/// The quantities of [`SENSORS`] the filter estimates: the biases always, each scale
+/// factor with its states.
+fn estimated_sensors(layout: Layout) -> impl Iterator<Item = &'static SensorQuantity> {
+    let estimated = [
+        true,
+        true,
+        layout.gyro_scale.is_some(),
+        layout.accel_scale.is_some(),
+    ];
+    SENSORS.iter().filter(move |q| estimated[q.block])
+}
+
+/// An estimate `est` once a second with its ±3σ envelope `sd3` about it, 320 px high.
+fn estimate_plot(c: &Ctx, title: &str, y_label: &str, est: &[f64], sd3: &[f64]) -> Plot {
+    let t: Vec<f64> = c.data.samples.iter().map(|x| c.rel(x.t)).collect();
+    let mut plot = with_envelope(
+        Plot::new(title, T_LABEL, y_label),
+        ("estimate", "estimate ± 3σ"),
+        &t,
+        est,
+        est,
+        sd3,
+    );
+    plot.height = 320;
+    plot
+}
+
+/// Axis `i` of the sensor quantity `q`: the estimate ± 3σ and, with `--sensor-truth`,
+/// the truth; GNSS gaps shaded.
+fn sensor_plot(c: &Ctx, q: &SensorQuantity, i: usize, axis: &str) -> Plot {
+    let samples = c.data.samples;
+    let est: Vec<f64> = samples
+        .iter()
+        .map(|x| sensor_block(&x.estimates, q.block)[i] / q.scale)
+        .collect();
+    let sd: Vec<f64> = samples
+        .iter()
+        .map(|x| 3.0 * x.sensor_std[q.block][i] / q.scale)
+        .collect();
+    let mut plot = estimate_plot(
+        c,
+        &format!("{} {axis}", q.name),
+        &format!("{}_{axis} [{}]", q.stem, q.unit),
+        &est,
+        &sd,
+    );
+    let sensor_truth = &c.data.settings.sensor_truth;
+    if !sensor_truth.is_empty() {
+        let tt: Vec<f64> = sensor_truth.iter().map(|x| c.rel(x.0)).collect();
+        let truth: Vec<f64> = sensor_truth
+            .iter()
+            .map(|x| sensor_block(&x.1, q.block)[i] / q.scale)
+            .collect();
+        plot = plot.line("truth", &tt, &truth, LineStyle::Dotted);
+    }
+    c.shade(plot)
+}
+
+/// The barometer bias [m] with its ±3σ envelope; GNSS gaps shaded.
+fn baro_bias_plot(c: &Ctx) -> Plot {
+    let samples = c.data.samples;
+    let est: Vec<f64> = samples.iter().map(|x| x.estimates.baro_bias).collect();
+    let sd: Vec<f64> = samples
+        .iter()
+        .map(|x| 3.0 * x.baro_std.unwrap_or(f64::NAN))
+        .collect();
+    c.shade(estimate_plot(
+        c,
+        "Barometer bias",
+        "baro bias [m]",
+        &est,
+        &sd,
+    ))
+}
+
+/// The last estimate of each estimated sensor quantity and of the barometer bias,
+/// with their 3σ (no row without a sample).
+fn final_estimates(samples: &[ReportSample], layout: Layout) -> Table {
+    let mut table = Table::new(["quantity", "unit", "x", "y", "z", "3σ x", "3σ y", "3σ z"]);
+    let Some(last) = samples.last() else {
+        return table;
+    };
+    for q in estimated_sensors(layout) {
+        let e = sensor_block(&last.estimates, q.block) / q.scale;
+        let sd = last.sensor_std[q.block] * 3.0 / q.scale;
+        table = table.row([
+            q.name.to_owned(),
+            q.unit.to_owned(),
+            f3(e.x),
+            f3(e.y),
+            f3(e.z),
+            f3(sd.x),
+            f3(sd.y),
+            f3(sd.z),
+        ]);
+    }
+    if layout.baro_bias.is_some() {
+        table = table.row([
+            "Barometer bias".to_owned(),
+            "m".to_owned(),
+            f3(last.estimates.baro_bias),
+            String::new(),
+            String::new(),
+            f3(3.0 * last.baro_std.unwrap_or(f64::NAN)),
+            String::new(),
+            String::new(),
+        ]);
+    }
+    table
+}
+
+/// The columns of `sensor_errors.csv` after `t`, each with its header name: per
+/// estimated quantity and axis the estimate and its σ in the quantity's unit, then the
+/// barometer bias and its σ [m].
+fn sensor_columns(layout: Layout) -> Vec<(String, Column)> {
+    let mut columns: Vec<(String, Column)> = Vec::new();
+    for q in estimated_sensors(layout) {
+        let u = q.unit.replace('/', "p");
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            let (block, scale) = (q.block, q.scale);
+            columns.push((
+                format!("{}_{axis}_{u}", q.stem),
+                Box::new(move |x: &ReportSample| sensor_block(&x.estimates, block)[i] / scale),
+            ));
+            columns.push((
+                format!("{}_{axis}_std_{u}", q.stem),
+                Box::new(move |x: &ReportSample| x.sensor_std[block][i] / scale),
+            ));
+        }
+    }
+    if layout.baro_bias.is_some() {
+        columns.push((
+            "baro_bias_m".to_owned(),
+            Box::new(|x: &ReportSample| x.estimates.baro_bias),
+        ));
+        columns.push((
+            "baro_bias_std_m".to_owned(),
+            Box::new(|x: &ReportSample| x.baro_std.unwrap_or(f64::NAN)),
+        ));
+    }
+    columns
+}
+
+/// The filter's sensor-error estimates: one plot per quantity and axis (and the
+/// barometer bias), the final values, and `sensor_errors.csv`.
 fn sensor_section(r: &mut Report, c: &Ctx) -> Result<()> {
     let data = c.data;
-    let samples = data.samples;
     let layout = data.facts.layout;
     let s = r.section("sensors", "Estimated sensor errors");
     s.paragraph(
@@ -640,128 +812,33 @@ fn sensor_section(r: &mut Report, c: &Ctx) -> Result<()> {
              it; `schuler simulate` does not write one yet.",
         );
     }
-    let t: Vec<f64> = samples.iter().map(|x| c.rel(x.t)).collect();
-    let tt: Vec<f64> = data
-        .settings
-        .sensor_truth
-        .iter()
-        .map(|x| c.rel(x.0))
-        .collect();
-    let estimated = [
-        true,
-        true,
-        layout.gyro_scale.is_some(),
-        layout.accel_scale.is_some(),
-    ];
-    let mut table = Table::new(["quantity", "unit", "x", "y", "z", "3σ x", "3σ y", "3σ z"]);
-    let mut header = String::from("t");
-    let mut columns: Vec<Column> = Vec::new();
-    for q in SENSORS.iter().filter(|q| estimated[q.block]) {
+    for q in estimated_sensors(layout) {
         for (i, axis) in ["x", "y", "z"].iter().enumerate() {
-            let est: Vec<f64> = samples
-                .iter()
-                .map(|x| sensor_block(&x.estimates, q.block)[i] / q.scale)
-                .collect();
-            let sd: Vec<f64> = samples
-                .iter()
-                .map(|x| 3.0 * x.sensor_std[q.block][i] / q.scale)
-                .collect();
-            let mut plot = with_envelope(
-                Plot::new(
-                    &format!("{} {axis}", q.name),
-                    T_LABEL,
-                    &format!("{}_{axis} [{}]", q.stem, q.unit),
-                ),
-                ("estimate", "estimate ± 3σ"),
-                &t,
-                &est,
-                &est,
-                &sd,
-            );
-            if !data.settings.sensor_truth.is_empty() {
-                let truth: Vec<f64> = data
-                    .settings
-                    .sensor_truth
-                    .iter()
-                    .map(|x| sensor_block(&x.1, q.block)[i] / q.scale)
-                    .collect();
-                plot = plot.line("truth", &tt, &truth, LineStyle::Dotted);
-            }
-            plot.height = 320;
-            let plot = c.shade(plot);
+            let plot = sensor_plot(c, q, i, axis);
             let svg = c.svg(&format!("{}_{axis}", q.stem), &plot)?;
             s.plot_with_files(&plot, &[&svg, "report/sensor_errors.csv"]);
-            let _ = write!(
-                header,
-                ",{}_{axis}_{u},{}_{axis}_std_{u}",
-                q.stem,
-                q.stem,
-                u = q.unit.replace('/', "p")
-            );
-            let (block, scale) = (q.block, q.scale);
-            columns.push(Box::new(move |x: &ReportSample| {
-                sensor_block(&x.estimates, block)[i] / scale
-            }));
-            columns.push(Box::new(move |x: &ReportSample| {
-                x.sensor_std[block][i] / scale
-            }));
-        }
-        if let Some(last) = samples.last() {
-            let e = sensor_block(&last.estimates, q.block) / q.scale;
-            let sd = last.sensor_std[q.block] * 3.0 / q.scale;
-            table = table.row([
-                q.name.to_owned(),
-                q.unit.to_owned(),
-                f3(e.x),
-                f3(e.y),
-                f3(e.z),
-                f3(sd.x),
-                f3(sd.y),
-                f3(sd.z),
-            ]);
         }
     }
     if layout.baro_bias.is_some() {
-        let est: Vec<f64> = samples.iter().map(|x| x.estimates.baro_bias).collect();
-        let sd: Vec<f64> = samples
-            .iter()
-            .map(|x| 3.0 * x.baro_std.unwrap_or(f64::NAN))
-            .collect();
-        let mut plot = with_envelope(
-            Plot::new("Barometer bias", T_LABEL, "baro bias [m]"),
-            ("estimate", "estimate ± 3σ"),
-            &t,
-            &est,
-            &est,
-            &sd,
-        );
-        plot.height = 320;
-        let plot = c.shade(plot);
+        let plot = baro_bias_plot(c);
         let svg = c.svg("baro_bias", &plot)?;
         s.plot_with_files(&plot, &[&svg, "report/sensor_errors.csv"]);
-        header.push_str(",baro_bias_m,baro_bias_std_m");
-        columns.push(Box::new(|x: &ReportSample| x.estimates.baro_bias));
-        columns.push(Box::new(|x: &ReportSample| x.baro_std.unwrap_or(f64::NAN)));
-        if let Some(last) = samples.last() {
-            table = table.row([
-                "Barometer bias".to_owned(),
-                "m".to_owned(),
-                f3(last.estimates.baro_bias),
-                String::new(),
-                String::new(),
-                f3(3.0 * last.baro_std.unwrap_or(f64::NAN)),
-                String::new(),
-                String::new(),
-            ]);
-        }
     }
-    s.table(table.caption("Final estimates and their 3σ"));
+    s.table(final_estimates(data.samples, layout).caption("Final estimates and their 3σ"));
+    let columns = sensor_columns(layout);
+    let header = columns
+        .iter()
+        .fold(String::from("t"), |h, (name, _)| h + "," + name);
     c.csv(
         "sensor_errors.csv",
         &header,
-        samples.iter().map(|x| {
+        data.samples.iter().map(|x| {
             std::iter::once(Some(x.t))
-                .chain(columns.iter().map(|c| Some(c(x)).filter(|v| v.is_finite())))
+                .chain(
+                    columns
+                        .iter()
+                        .map(|(_, f)| Some(f(x)).filter(|v| v.is_finite())),
+                )
                 .collect()
         }),
     )?;

@@ -106,24 +106,31 @@ pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
     Ok(())
 }
 
-/// Check the vehicle options and load their files.
-pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, VehicleReadings)> {
-    check_dependencies(o)?;
-    let positive = |flag: &str, v: &Option<String>, dim: Dimension, default: f64| {
-        let x = quantity(flag, v, dim)?.unwrap_or(default);
-        if x <= 0.0 {
-            bail!("--{flag} must be positive, got {x}");
-        }
-        Ok(x)
-    };
+/// The value of `--flag` with its unit (or `default` when not given), which must be
+/// positive.
+fn positive(flag: &str, v: &Option<String>, dim: Dimension, default: f64) -> Result<f64> {
+    let x = quantity(flag, v, dim)?.unwrap_or(default);
+    if x <= 0.0 {
+        bail!("--{flag} must be positive, got {x}");
+    }
+    Ok(x)
+}
+
+/// Zero-velocity updates (`--zupt FILE`, its intervals read into `rests`, or
+/// `--zupt-detect`) with their noise, interval and optional zero-rate updates; `None`
+/// without either.
+fn rest_config(
+    o: &AidingOptions,
+    noise: &ImuNoise,
+    rests: &mut Vec<(f64, f64)>,
+) -> Result<Option<RestConfig>> {
     let interval = positive("zupt-interval", &o.zupt_interval, Dimension::Time, 0.1)?;
-    let mut readings = VehicleReadings::default();
     let source = match (&o.zupt, o.zupt_detect) {
         (Some(path), _) => {
-            readings.rests = crate::formats::vehicle::read_rest_intervals(path)?;
-            Some(RestSource::Intervals)
+            *rests = crate::formats::vehicle::read_rest_intervals(path)?;
+            RestSource::Intervals
         }
-        (None, true) => Some(RestSource::Detect {
+        (None, true) => RestSource::Detect {
             noise: *noise,
             max_speed: positive(
                 "zupt-max-speed",
@@ -131,40 +138,40 @@ pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, Ve
                 Dimension::Velocity,
                 0.5,
             )?,
-        }),
-        (None, false) => None,
+        },
+        (None, false) => return Ok(None),
     };
-    let rest = match source {
-        None => None,
-        Some(source) => Some(RestConfig {
-            source,
-            std: positive("zupt-std", &o.zupt_std, Dimension::Velocity, 0.02)?,
-            interval,
-            zaru_std: if o.zaru {
-                let white = noise.arw.max() / interval.sqrt();
-                Some(positive(
-                    "zaru-std",
-                    &o.zaru_std,
-                    Dimension::AngularRate,
-                    white,
-                )?)
-            } else {
-                None
-            },
-        }),
-    };
-    let nhc = if o.nhc {
-        Some((
-            positive("nhc-std", &o.nhc_std, Dimension::Velocity, 0.1)?,
-            positive("nhc-interval", &o.nhc_interval, Dimension::Time, 0.1)?,
-        ))
+    let std = positive("zupt-std", &o.zupt_std, Dimension::Velocity, 0.02)?;
+    let zaru_std = if o.zaru {
+        // Default: the gyro's white noise averaged over one interval.
+        let white = noise.arw.max() / interval.sqrt();
+        Some(positive(
+            "zaru-std",
+            &o.zaru_std,
+            Dimension::AngularRate,
+            white,
+        )?)
     } else {
         None
     };
+    Ok(Some(RestConfig {
+        source,
+        std,
+        interval,
+        zaru_std,
+    }))
+}
+
+/// The odometer's speed noise (`--odometer FILE`, its readings read into `readings`)
+/// and its scale-factor prior (`--odometer-scale-std`).
+fn odometer(
+    o: &AidingOptions,
+    readings: &mut Vec<(f64, f64)>,
+) -> Result<(Option<f64>, Option<f64>)> {
     let odometer_std = match &o.odometer {
         None => None,
         Some(path) => {
-            readings.odometer = crate::formats::vehicle::read_odometer(path)?;
+            *readings = crate::formats::vehicle::read_odometer(path)?;
             Some(positive(
                 "odometer-std",
                 &o.odometer_std,
@@ -182,40 +189,76 @@ pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, Ve
             0.0,
         )?),
     };
-    let finite = |flag: &str, v: Option<f64>| -> Result<f64> {
-        let x = v.unwrap_or(0.0);
-        if !x.is_finite() {
-            bail!("--{flag} must be a finite angle in degrees, got {x}");
-        }
-        Ok(x.to_radians())
+    Ok((odometer_std, odometer_scale_std))
+}
+
+/// The angle of `--flag` in degrees (0 when not given) in radians, which must be
+/// finite.
+fn finite_degrees(flag: &str, v: Option<f64>) -> Result<f64> {
+    let x = v.unwrap_or(0.0);
+    if !x.is_finite() {
+        bail!("--{flag} must be a finite angle in degrees, got {x}");
+    }
+    Ok(x.to_radians())
+}
+
+/// The dual-antenna baseline (`--dual-antenna FILE`, its headings read into
+/// `headings`): yaw and pitch from the IMU's front, not within 1° of the vertical.
+fn heading_baseline(
+    o: &AidingOptions,
+    headings: &mut Vec<HeadingReading>,
+) -> Result<Option<Baseline>> {
+    let Some(path) = &o.dual_antenna else {
+        return Ok(None);
     };
-    let heading_baseline = match &o.dual_antenna {
-        None => None,
-        Some(path) => {
-            let baseline = Baseline {
-                yaw: finite("dual-antenna-baseline-yaw", o.dual_antenna_baseline_yaw)?,
-                pitch: finite("dual-antenna-baseline-pitch", o.dual_antenna_baseline_pitch)?,
-            };
-            if baseline.pitch.abs() >= 89f64.to_radians() {
-                bail!(
-                    "--dual-antenna-baseline-pitch: a baseline within 1° of the vertical has no heading"
-                );
-            }
-            readings.headings = crate::formats::vehicle::read_heading(path)?;
-            Some(baseline)
-        }
+    let baseline = Baseline {
+        yaw: finite_degrees("dual-antenna-baseline-yaw", o.dual_antenna_baseline_yaw)?,
+        pitch: finite_degrees("dual-antenna-baseline-pitch", o.dual_antenna_baseline_pitch)?,
     };
-    let triple = |flag: &str, v: &Option<crate::options::Triple>| -> Result<[f64; 3]> {
-        let t = v.map_or([0.0; 3], |t| t.0);
-        if t.iter().any(|x| !x.is_finite()) {
-            bail!("--{flag} must be three finite numbers, got {t:?}");
-        }
-        Ok(t)
+    if baseline.pitch.abs() >= 89f64.to_radians() {
+        bail!("--dual-antenna-baseline-pitch: a baseline within 1° of the vertical has no heading");
+    }
+    *headings = crate::formats::vehicle::read_heading(path)?;
+    Ok(Some(baseline))
+}
+
+/// Three numbers of `--flag` (zeros when not given), which must be finite.
+fn finite_triple(flag: &str, v: &Option<crate::options::Triple>) -> Result<[f64; 3]> {
+    let t = v.map_or([0.0; 3], |t| t.0);
+    if t.iter().any(|x| !x.is_finite()) {
+        bail!("--{flag} must be three finite numbers, got {t:?}");
+    }
+    Ok(t)
+}
+
+/// How the vehicle sits on the IMU: `--mounting-angles` [deg] and
+/// `--vehicle-lever-arm` [m].
+fn mount(o: &AidingOptions) -> Result<VehicleMount> {
+    let [roll, pitch, yaw] = finite_triple("mounting-angles", &o.mounting_angles)?;
+    let lever = finite_triple("vehicle-lever-arm", &o.vehicle_lever_arm)?;
+    Ok(VehicleMount::new(
+        Euler::from_degrees(roll, pitch, yaw),
+        Vector3::from(lever),
+    ))
+}
+
+/// Check the vehicle options and load their files.
+pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, VehicleReadings)> {
+    check_dependencies(o)?;
+    let mut readings = VehicleReadings::default();
+    let rest = rest_config(o, noise, &mut readings.rests)?;
+    let nhc = if o.nhc {
+        Some((
+            positive("nhc-std", &o.nhc_std, Dimension::Velocity, 0.1)?,
+            positive("nhc-interval", &o.nhc_interval, Dimension::Time, 0.1)?,
+        ))
+    } else {
+        None
     };
-    let [roll, pitch, yaw] = triple("mounting-angles", &o.mounting_angles)?;
-    let lever = triple("vehicle-lever-arm", &o.vehicle_lever_arm)?;
+    let (odometer_std, odometer_scale_std) = odometer(o, &mut readings.odometer)?;
+    let heading_baseline = heading_baseline(o, &mut readings.headings)?;
     let config = VehicleConfig {
-        mount: VehicleMount::new(Euler::from_degrees(roll, pitch, yaw), Vector3::from(lever)),
+        mount: mount(o)?,
         rest,
         nhc,
         odometer_std,

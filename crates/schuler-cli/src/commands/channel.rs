@@ -8,7 +8,10 @@
 //! and the plots `dr.svg` (km), `dv.svg` (m/s), `alpha.svg` (arcsec), like the text's
 //! figures 4-15. Every value with a unit goes through `schuler::units`.
 
-use crate::plot::{LineStyle, Plot};
+use crate::options::{
+    SphereArgs, acceleration, angle, angular_rate, is_positive, length, ratio, time, velocity,
+};
+use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use schuler::channel::ChannelError;
@@ -16,59 +19,11 @@ use schuler::channel::linear::ErrorState;
 use schuler::channel::models::{Alignment, SensorErrors, System};
 use schuler::channel::profile::{BodyAngleProfile, SpeedProfile};
 use schuler::channel::run::{ChannelConfig, ChannelRun, simulate};
-use schuler::earth::Sphere;
-use schuler::units::{self, ARCSEC, DEG, Dimension};
+use schuler::units::{ARCSEC, DEG};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-
-// ---------------------------------------------------------------------------------------
-// Flag values with units (shared with `schuler vertical`).
-
-fn quantity(s: &str, dim: Dimension) -> Result<f64, String> {
-    units::parse_as(s, dim).map_err(|e| e.to_string())
-}
-
-/// An acceleration with its unit (`1e-3m/s^2`, `100ug`, `1mGal`) in m/s^2.
-pub(crate) fn acceleration(s: &str) -> Result<f64, String> {
-    quantity(s, Dimension::Acceleration)
-}
-
-/// An angular rate with its unit (`0.01deg/h`, `6deg/s`) in rad/s.
-pub(crate) fn angular_rate(s: &str) -> Result<f64, String> {
-    quantity(s, Dimension::AngularRate)
-}
-
-/// An angle with its unit (`20arcsec`, `180deg`) in rad.
-pub(crate) fn angle(s: &str) -> Result<f64, String> {
-    quantity(s, Dimension::Angle)
-}
-
-/// A velocity with its unit (`1m/s`, `250kn`) in m/s.
-pub(crate) fn velocity(s: &str) -> Result<f64, String> {
-    quantity(s, Dimension::Velocity)
-}
-
-/// A length with its unit (`100m`, `6371km`) in m.
-pub(crate) fn length(s: &str) -> Result<f64, String> {
-    quantity(s, Dimension::Length)
-}
-
-/// A time with its unit (`4h`, `0.1s`) in s.
-pub(crate) fn time(s: &str) -> Result<f64, String> {
-    quantity(s, Dimension::Time)
-}
-
-/// A ratio: a bare number or with `ppm`, `ppb`, `%`.
-pub(crate) fn ratio(s: &str) -> Result<f64, String> {
-    units::parse_as_or_si(s, Dimension::Dimensionless).map_err(|e| e.to_string())
-}
-
-/// True for a number > 0 (false for NaN).
-pub(crate) fn is_positive(x: f64) -> bool {
-    x > 0.0
-}
 
 /// `AT:ANGLE[:DURATION]`, e.g. `1h:180deg` or `1h:180deg:20s`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -202,30 +157,6 @@ pub struct Args {
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-}
-
-/// The textbook sphere's radius and surface gravitation (shared with `schuler vertical`).
-#[derive(clap::Args, Debug, Clone, Copy)]
-pub struct SphereArgs {
-    /// Sphere radius a.
-    #[arg(long, value_parser = length, allow_hyphen_values = true, default_value = "6371km", value_name = "LENGTH")]
-    pub radius: f64,
-    /// Gravitation at the surface g.
-    #[arg(long, value_parser = acceleration, allow_hyphen_values = true, default_value = "9.81m/s^2", value_name = "ACCEL")]
-    pub g: f64,
-}
-
-impl SphereArgs {
-    /// The sphere rotating at `rate`, after checking both values are positive.
-    pub fn sphere(&self, rate: f64) -> Result<Sphere> {
-        if !is_positive(self.radius) {
-            bail!("--radius must be positive, got {} m", self.radius);
-        }
-        if !is_positive(self.g) {
-            bail!("--g must be positive, got {} m/s^2", self.g);
-        }
-        Ok(Sphere::with_surface_gravity(self.radius, self.g, rate))
-    }
 }
 
 /// Builds the library scenario from the flags, naming the flag on any inconsistency.
@@ -461,17 +392,6 @@ fn summary(cfg: &ChannelConfig, run: &ChannelRun) -> Value {
         },
         "files": ["errors.csv", "summary.json", "dr.svg", "dv.svg", "alpha.svg"],
     })
-}
-
-/// Time axis: hours for runs of 2 h or more, minutes from 10 min, else seconds.
-pub(crate) fn time_axis(duration: f64) -> (f64, &'static str) {
-    if duration >= 7200.0 {
-        (3600.0, "t [h]")
-    } else if duration >= 600.0 {
-        (60.0, "t [min]")
-    } else {
-        (1.0, "t [s]")
-    }
 }
 
 /// Writes `dr.svg`, `dv.svg`, `alpha.svg`.

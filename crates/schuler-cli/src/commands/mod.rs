@@ -10,3 +10,12 @@ pub mod nav;
 pub mod platform;
 pub mod simulate;
 pub mod vertical;
+
+/// `schuler nav`: a KF-GINS configuration (`--kf-gins-config`) runs as KF-GINS does
+/// ([`kf_gins::run`]), anything else as [`nav::run`].
+pub fn run_nav(args: nav::NavArgs) -> anyhow::Result<()> {
+    match &args.kf_gins_config {
+        Some(path) => kf_gins::run(path),
+        None => nav::run(args),
+    }
+}

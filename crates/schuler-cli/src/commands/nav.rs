@@ -421,11 +421,9 @@ fn start_in_motion(
     Ok((Start::from_motion(&m), samples[m.sample..].to_vec()))
 }
 
-/// `schuler nav`.
+/// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
+/// [`crate::commands::run_nav`]).
 pub fn run(args: NavArgs) -> Result<()> {
-    if let Some(path) = &args.kf_gins_config {
-        return super::kf_gins::run(path);
-    }
     let NavPlan {
         settings,
         align,

@@ -14,10 +14,11 @@
 //! `tilt_east.svg`, `heading.svg`), the table of errors at 1 h (or at the end of a
 //! shorter run) as `table.csv` and `table.md`, and `summary.json`.
 
-use crate::plot::{LineStyle, Plot};
+use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use nalgebra::{Vector3, Vector6};
 use schuler::earth::{EarthModel, Sphere, Wgs84};
+use schuler::imu::model::ImuModel;
 use schuler::lab::platform::compare::{CompareConfig, Comparison, NavError, SystemKind, compare};
 use schuler::lab::platform::{AccelerometerArray, InstrumentErrors, VerticalChannel};
 use schuler::sim::run::EarthSpec;
@@ -154,37 +155,95 @@ pub fn load(path: &Path) -> Result<Config> {
     parse(spec).with_context(|| format!("in {}", path.display()))
 }
 
-fn parse(spec: ConfigSpec) -> Result<Config> {
-    let positive = |x: f64, key: &str| -> Result<f64> {
-        if x.is_finite() && x > 0.0 {
-            Ok(x)
-        } else {
-            bail!("{key}: must be positive, got {x}")
-        }
-    };
-    let duration = spec
-        .duration
-        .as_ref()
-        .map(|q| si(q, "duration", Dimension::Time).and_then(|x| positive(x, "duration")))
-        .transpose()?;
-    let step = match &spec.step {
-        Some(q) => positive(si(q, "step", Dimension::Time)?, "step")?,
-        None => 0.1,
-    };
-    let (imu_rate, sensor_model) = match (&spec.imu, spec.imu_rate_hz) {
+/// `x`, which must be finite and positive (the error names `key`).
+fn positive(x: f64, key: &str) -> Result<f64> {
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        bail!("{key}: must be positive, got {x}")
+    }
+}
+
+/// The positive value of `key` in SI (`default` when not given).
+fn positive_or(q: &Option<Quantity>, key: &str, dim: Dimension, default: f64) -> Result<f64> {
+    match q {
+        Some(q) => positive(si(q, key, dim)?, key),
+        None => Ok(default),
+    }
+}
+
+/// The SINS's IMU rate [Hz] and the simulator's sensor model: `[imu]`'s rate and
+/// model, or `imu_rate_hz` (default 100 Hz) and none; not both.
+fn imu_settings(spec: &ConfigSpec) -> Result<(f64, Option<ImuModel>)> {
+    Ok(match (&spec.imu, spec.imu_rate_hz) {
         (Some(_), Some(_)) => {
             bail!("imu_rate_hz: give the SINS rate once, as imu.rate_hz when [imu] is present")
         }
         (Some(imu), None) => (imu.rate_hz, Some(imu.model()?)),
         (None, rate) => (positive(rate.unwrap_or(100.0), "imu_rate_hz")?, None),
+    })
+}
+
+/// The gyro-free INS's accelerometer array (`[gyro_free]`: layout, baseline, default
+/// 0.5 m) and its six biases (default: the triad's `accel_bias` magnitudes with
+/// alternating signs: independent instruments, and equal signs would cancel in the
+/// cube's differences).
+fn gyro_free(
+    spec: &GyroFreeSpec,
+    accel_bias: Vector3<f64>,
+) -> Result<(AccelerometerArray, Vector6<f64>)> {
+    let rho = positive_or(&spec.baseline, "gyro_free.baseline", Dimension::Length, 0.5)?;
+    let array = match spec.layout {
+        LayoutSpec::Cube => AccelerometerArray::cube(rho),
+        LayoutSpec::TriadAndOffsets => AccelerometerArray::triad_and_offsets(rho),
+    }
+    .context("gyro_free.layout")?;
+    let b = accel_bias;
+    let biases = match &spec.accel_bias {
+        Some(q) => {
+            let mut v = Vector6::zeros();
+            for k in 0..6 {
+                v[k] = si(
+                    &q[k],
+                    &format!("gyro_free.accel_bias[{k}]"),
+                    Dimension::Acceleration,
+                )?;
+            }
+            v
+        }
+        None => Vector6::new(b.x, -b.y, b.z, -b.x, b.y, -b.z),
     };
-    let output_interval = match &spec.output_interval {
-        Some(q) => positive(
-            si(q, "output_interval", Dimension::Time)?,
-            "output_interval",
-        )?,
-        None => 10.0,
-    };
+    Ok((array, biases))
+}
+
+/// The systems compared: those `systems` names (at least one), or all.
+fn systems(names: &Option<Vec<String>>) -> Result<Vec<SystemKind>> {
+    match names {
+        Some(names) if names.is_empty() => bail!("systems: empty; name at least one system"),
+        Some(names) => names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| system_by_name(n, i))
+            .collect(),
+        None => Ok(SystemKind::ALL.to_vec()),
+    }
+}
+
+/// The checked config of `spec`; errors name the key.
+fn parse(spec: ConfigSpec) -> Result<Config> {
+    let duration = spec
+        .duration
+        .as_ref()
+        .map(|q| si(q, "duration", Dimension::Time).and_then(|x| positive(x, "duration")))
+        .transpose()?;
+    let step = positive_or(&spec.step, "step", Dimension::Time, 0.1)?;
+    let (imu_rate, sensor_model) = imu_settings(&spec)?;
+    let output_interval = positive_or(
+        &spec.output_interval,
+        "output_interval",
+        Dimension::Time,
+        10.0,
+    )?;
     let errors = InstrumentErrors {
         accel_bias: vec3(
             &spec.errors.accel_bias,
@@ -197,44 +256,8 @@ fn parse(spec: ConfigSpec) -> Result<Config> {
             Dimension::AngularRate,
         )?,
     };
-    let rho = match &spec.gyro_free.baseline {
-        Some(q) => positive(
-            si(q, "gyro_free.baseline", Dimension::Length)?,
-            "gyro_free.baseline",
-        )?,
-        None => 0.5,
-    };
-    let array = match spec.gyro_free.layout {
-        LayoutSpec::Cube => AccelerometerArray::cube(rho),
-        LayoutSpec::TriadAndOffsets => AccelerometerArray::triad_and_offsets(rho),
-    }
-    .context("gyro_free.layout")?;
-    let b = errors.accel_bias;
-    let gyro_free_biases = match &spec.gyro_free.accel_bias {
-        Some(q) => {
-            let mut v = Vector6::zeros();
-            for k in 0..6 {
-                v[k] = si(
-                    &q[k],
-                    &format!("gyro_free.accel_bias[{k}]"),
-                    Dimension::Acceleration,
-                )?;
-            }
-            v
-        }
-        // The triad's magnitudes with alternating signs: independent instruments, and
-        // equal signs would cancel in the cube's differences.
-        None => Vector6::new(b.x, -b.y, b.z, -b.x, b.y, -b.z),
-    };
-    let systems = match &spec.systems {
-        Some(names) if names.is_empty() => bail!("systems: empty; name at least one system"),
-        Some(names) => names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| system_by_name(n, i))
-            .collect::<Result<Vec<_>>>()?,
-        None => SystemKind::ALL.to_vec(),
-    };
+    let (array, gyro_free_biases) = gyro_free(&spec.gyro_free, errors.accel_bias)?;
+    let systems = systems(&spec.systems)?;
     Ok(Config {
         earth: spec.earth,
         duration,
@@ -423,7 +446,7 @@ fn write_errors_csv(path: &Path, c: &Comparison) -> Result<()> {
 /// above every other's (the gyro-free INS, usually) is drawn only until it passes 1.5
 /// times the next peak, and labelled with that time, so the others keep the scale.
 fn write_plots(dir: &Path, c: &Comparison) -> Result<()> {
-    let (tscale, tlabel) = super::channel::time_axis(c.times[c.times.len() - 1] - c.times[0]);
+    let (tscale, tlabel) = time_axis(c.times[c.times.len() - 1] - c.times[0]);
     let t: Vec<f64> = c.times.iter().map(|x| (x - c.times[0]) / tscale).collect();
     let styles = [LineStyle::Solid, LineStyle::Dashed, LineStyle::Dotted];
     for q in &QUANTITIES {

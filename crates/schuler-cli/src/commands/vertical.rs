@@ -11,8 +11,8 @@
 //! (eigenvalues, e-fold time, settling and reconvergence times, detector counts) and the
 //! plots `dh.svg`, `dvh.svg`.
 
-use super::channel::{SphereArgs, acceleration, is_positive, length, time, time_axis, velocity};
-use crate::plot::{LineStyle, Plot};
+use crate::options::{SphereArgs, acceleration, is_positive, length, time, velocity};
+use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use schuler::channel::ChannelError;
@@ -22,7 +22,7 @@ use schuler::channel::kalman::{KalmanRun, KalmanTuning, simulate_kalman};
 use schuler::channel::measure::{e_fold_time, peak_abs, settling_time};
 use schuler::channel::reference::{Dropout, Outlier, ReferenceConfig};
 use schuler::channel::vertical::{
-    AidedRun, Gains, Mode, VerticalConfig, VerticalSample, closed_loop_response, outages,
+    AidedRun, Gains, Mode, Outage, VerticalConfig, VerticalSample, closed_loop_response, outages,
     simulate_aided, simulate_free,
 };
 use schuler::units::{self, Dimension};
@@ -337,14 +337,21 @@ fn inputs_json(cfg: &VerticalConfig) -> Value {
     })
 }
 
-fn run_aided(cfg: &VerticalConfig, args: &Args) -> Result<Value> {
+/// The loop's gains: `--k1`/`--k2` as given, or critically damped for
+/// `--time-constant` (default 20 s); checked stable (37) and resolved by the step.
+fn aided_gains(cfg: &VerticalConfig, args: &Args) -> Result<Gains> {
     let w0_sq = cfg.w0_sq();
     let gains = match (args.k1, args.k2, args.time_constant) {
         (Some(k1), Some(k2), _) => Gains { k1, k2 },
         (_, _, tau) => Gains::critical(tau.unwrap_or(20.0), w0_sq).map_err(explain)?,
     };
     gains.check(w0_sq, cfg.dt).map_err(explain)?;
-    let reference_cfg = ReferenceConfig {
+    Ok(gains)
+}
+
+/// The simulated reference height's errors: noise, bias, outliers and dropouts.
+fn reference_config(args: &Args) -> ReferenceConfig {
+    ReferenceConfig {
         noise: args.ref_noise,
         bias: args.ref_bias,
         outliers: args.ref_outlier.clone(),
@@ -352,134 +359,232 @@ fn run_aided(cfg: &VerticalConfig, args: &Args) -> Result<Value> {
         outlier_size: args.ref_outlier_size,
         dropouts: args.ref_dropout.clone(),
         seed: args.seed,
-    };
-    let grid = cfg.grid();
-    let reference = reference_cfg.generate(cfg.height, &grid).map_err(explain)?;
-    let detector = DetectorConfig {
-        enabled: !args.no_fault_detector,
-        gate: args.gate,
-        reacquire: args.reacquire,
-    };
-    let loop_run = simulate_aided(cfg, gains, &reference, detector).map_err(explain)?;
-    let tuning = KalmanTuning {
+    }
+}
+
+/// The Kalman variant's tuning: its accelerometer noise, the reference sigma (at least
+/// 0.1 m) and initial sigmas from the initial errors (at least 10 m and 1 m/s).
+fn kalman_tuning(args: &Args) -> KalmanTuning {
+    KalmanTuning {
         accel_noise: args.kf_accel_noise,
         ref_sigma: args.ref_noise.max(0.1),
         sigma_h0: args.init_height_error.abs().max(10.0),
         sigma_v0: args.init_vel_error.abs().max(1.0),
         gate_sigmas: 5.0,
-    };
-    // The filter gates on its own innovation sigma (`gate_sigmas`), not on `--gate`.
-    let kf = simulate_kalman(cfg, tuning, &reference, detector).map_err(explain)?;
+    }
+}
 
-    write_samples(&args.out.join("vertical.csv"), &loop_run.samples)?;
-    write_kf(&args.out.join("vertical_kf.csv"), &kf)?;
-    write_reference(
-        &args.out.join("reference.csv"),
-        &grid,
-        &reference,
-        cfg.height,
-    )?;
+/// The aided mode's two runs on the same reference samples, with their settings.
+struct AidedRuns {
+    /// The constant-gain loop's gains.
+    gains: Gains,
+    /// The fault detector's settings.
+    detector: DetectorConfig,
+    /// The Kalman variant's tuning.
+    tuning: KalmanTuning,
+    /// The constant-gain loop (34) with prediction (38).
+    loop_run: AidedRun,
+    /// The Kalman variant.
+    kf: KalmanRun,
+}
 
-    // Steady state relative to truth of (37) forced by the reference and accelerometer
-    // biases; the transient is the homogeneous solution from (x0 - x_ss).
-    let (steady, steady_v) = gains.steady_state(w0_sq, args.ref_bias, cfg.accel_bias);
-    let taus = gains.time_constants(w0_sq);
-    // Noise floor of the settling band: a critically damped loop passes white reference
-    // noise (variance σ² per sample of length dt) through an equivalent noise bandwidth
-    // of 1.25/τ, so its height error has σ_f = σ sqrt(1.25 dt/τ); five of those.
-    let floor = |tau: f64| (5.0 * args.ref_noise * (1.25 * cfg.dt / tau).sqrt()).max(1e-3);
-    let fraction = 0.05;
-    let t: Vec<f64> = loop_run.samples.iter().map(|s| s.t).collect();
-    let dh: Vec<f64> = loop_run.samples.iter().map(|s| s.dh).collect();
-    let first_predict = loop_run
-        .samples
+/// Noise floor of the settling band [m]: a critically damped loop of time constant
+/// `tau` passes white reference noise (variance σ² per sample of length dt) through an
+/// equivalent noise bandwidth of 1.25/τ, so its height error has σ_f = σ sqrt(1.25 dt/τ);
+/// five of those (at least 1 mm).
+fn noise_floor(ref_noise: f64, dt: f64, tau: f64) -> f64 {
+    (5.0 * ref_noise * (1.25 * dt / tau).sqrt()).max(1e-3)
+}
+
+/// Fraction of the initial error that bounds the settling band.
+const SETTLING_FRACTION: f64 = 0.05;
+
+/// How the loop settles and recovers: steady state of (37), the settling band and
+/// times, and the outages of the loop and of the filter.
+struct AidedAnalysis {
+    /// The loop's time constants [s], slowest first.
+    taus: [f64; 2],
+    /// Steady-state height and vertical-velocity errors [m, m/s] forced by the
+    /// reference and accelerometer biases.
+    steady: (f64, f64),
+    /// Half-width of the settling band [m].
+    band: f64,
+    /// Settling time measured on the loop's run and on the noise-free solution [s].
+    settling: (Option<f64>, Option<f64>),
+    /// The loop's prediction intervals and its reconvergence after each.
+    outages: Vec<Outage>,
+    /// The filter's final equivalent gains.
+    kf_final: Option<Gains>,
+    /// The filter's prediction intervals and its reconvergence after each.
+    kf_outages: Vec<Outage>,
+}
+
+/// Settling time of the loop's height error into `band` around `steady` before its
+/// first prediction, measured and on the noise-free solution exp(A t) (x0 - x_ss) of
+/// (37) from the initial errors less the steady state `(e0, v0)`.
+fn settling_times(
+    samples: &[VerticalSample],
+    gains: &Gains,
+    w0_sq: f64,
+    steady: f64,
+    band: f64,
+    (e0, v0): (f64, f64),
+) -> (Option<f64>, Option<f64>) {
+    let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    let dh: Vec<f64> = samples.iter().map(|s| s.dh).collect();
+    let first_predict = samples
         .iter()
         .position(|s| s.mode == Mode::Predict)
         .unwrap_or(dh.len());
-    let e0 = cfg.init_height_error - steady;
-    let v0 = cfg.init_vel_error - steady_v;
-    let band = (fraction * e0.abs()).max(floor(taus[0]));
-    let settling = settling_time(&t, &dh, steady, band, 0, first_predict);
-    // Theory: the same band on the noise-free solution exp(A t) (x0 - x_ss) of (37).
+    let measured = settling_time(&t, &dh, steady, band, 0, first_predict);
     let theory_curve: Vec<f64> = t
         .iter()
         .map(|&ti| {
-            closed_loop_response(&gains, w0_sq, e0, v0, ti)
+            closed_loop_response(gains, w0_sq, e0, v0, ti)
                 .map(|(h, _)| h)
                 .unwrap_or(f64::NAN)
         })
         .collect();
-    let settling_theory = settling_time(&t, &theory_curve, 0.0, band, 0, t.len());
-    let outs = outages(&loop_run.samples, steady, fraction, floor(taus[0]));
-    // The filter's steady state: the same formula with its final equivalent gains.
+    (
+        measured,
+        settling_time(&t, &theory_curve, 0.0, band, 0, t.len()),
+    )
+}
+
+/// The filter's final equivalent gains (of its last aided sample) and its outages,
+/// each measured against the steady state of those gains (the reference bias and the
+/// loop's `tau` without them).
+fn kalman_outages(
+    cfg: &VerticalConfig,
+    args: &Args,
+    kf: &KalmanRun,
+    tau: f64,
+) -> (Option<Gains>, Vec<Outage>) {
+    let w0_sq = cfg.w0_sq();
     let kf_final = kf
         .samples
         .iter()
         .rev()
         .find(|s| s.mode == Mode::Aided)
         .map(|s| Gains { k1: s.k1, k2: s.k2 });
-    let outs_kf = {
-        let as_loop: Vec<VerticalSample> = kf
-            .samples
-            .iter()
-            .map(|s| VerticalSample {
-                t: s.t,
-                dh: s.dh,
-                dvh: s.dvh,
-                mode: s.mode,
-            })
-            .collect();
-        let (target, tau) = kf_final.map_or((args.ref_bias, taus[0]), |g| {
-            (
-                g.steady_state(w0_sq, args.ref_bias, cfg.accel_bias).0,
-                g.time_constants(w0_sq)[0],
-            )
-        });
-        outages(&as_loop, target, fraction, floor(tau))
-    };
-    let outage_json = |v: &[schuler::channel::vertical::Outage]| -> Value {
-        Value::Array(
-            v.iter()
-                .filter(|o| o.end - o.start > cfg.dt * 1.5)
-                .map(|o| {
-                    json!({
-                        "start_s": o.start,
-                        "reconnect_s": o.end,
-                        "error_at_reconnect_m": o.error_at_reconnect,
-                        "reconverge_time_s": o.reconverge_time,
-                        "reconverge_time_constants": o.reconverge_time.map(|r| r / taus[0]),
-                    })
-                })
-                .collect(),
+    let as_loop: Vec<VerticalSample> = kf
+        .samples
+        .iter()
+        .map(|s| VerticalSample {
+            t: s.t,
+            dh: s.dh,
+            dvh: s.dvh,
+            mode: s.mode,
+        })
+        .collect();
+    let (target, tau) = kf_final.map_or((args.ref_bias, tau), |g| {
+        (
+            g.steady_state(w0_sq, args.ref_bias, cfg.accel_bias).0,
+            g.time_constants(w0_sq)[0],
         )
-    };
-    write_aided_plots(&args.out, cfg, &loop_run, &kf)?;
-    Ok(json!({
+    });
+    let floor = noise_floor(args.ref_noise, cfg.dt, tau);
+    (
+        kf_final,
+        outages(&as_loop, target, SETTLING_FRACTION, floor),
+    )
+}
+
+/// Steady state, settling and outages of both runs.
+fn analyse(cfg: &VerticalConfig, args: &Args, runs: &AidedRuns) -> AidedAnalysis {
+    let w0_sq = cfg.w0_sq();
+    let (steady, steady_v) = runs
+        .gains
+        .steady_state(w0_sq, args.ref_bias, cfg.accel_bias);
+    let taus = runs.gains.time_constants(w0_sq);
+    let floor = noise_floor(args.ref_noise, cfg.dt, taus[0]);
+    let e0 = cfg.init_height_error - steady;
+    let v0 = cfg.init_vel_error - steady_v;
+    let band = (SETTLING_FRACTION * e0.abs()).max(floor);
+    let samples = &runs.loop_run.samples;
+    let settling = settling_times(samples, &runs.gains, w0_sq, steady, band, (e0, v0));
+    let (kf_final, kf_outages) = kalman_outages(cfg, args, &runs.kf, taus[0]);
+    AidedAnalysis {
+        taus,
+        steady: (steady, steady_v),
+        band,
+        settling,
+        outages: outages(samples, steady, SETTLING_FRACTION, floor),
+        kf_final,
+        kf_outages,
+    }
+}
+
+/// The outages longer than 1.5 steps, with reconvergence times also in units of the
+/// loop's time constant `tau`.
+fn outage_json(v: &[Outage], dt: f64, tau: f64) -> Value {
+    Value::Array(
+        v.iter()
+            .filter(|o| o.end - o.start > dt * 1.5)
+            .map(|o| {
+                json!({
+                    "start_s": o.start,
+                    "reconnect_s": o.end,
+                    "error_at_reconnect_m": o.error_at_reconnect,
+                    "reconverge_time_s": o.reconverge_time,
+                    "reconverge_time_constants": o.reconverge_time.map(|r| r / tau),
+                })
+            })
+            .collect(),
+    )
+}
+
+/// The reference's settings as given.
+fn reference_json(args: &Args) -> Value {
+    json!({
+        "noise_m": args.ref_noise,
+        "bias_m": args.ref_bias,
+        "outliers": args.ref_outlier.iter().map(|o| json!({"t_s": o.t, "size_m": o.size})).collect::<Vec<_>>(),
+        "outlier_probability": args.ref_outlier_prob,
+        "outlier_size_m": args.ref_outlier_size,
+        "dropouts": args.ref_dropout.iter().map(|d| json!({"start_s": d.start, "duration_s": d.duration})).collect::<Vec<_>>(),
+        "seed": args.seed,
+    })
+}
+
+/// The Kalman variant's tuning, final gains, detector counts and outages.
+fn kalman_json(cfg: &VerticalConfig, runs: &AidedRuns, a: &AidedAnalysis) -> Value {
+    let (tuning, kf) = (&runs.tuning, &runs.kf);
+    json!({
+        "accel_noise_m_s_sqrt_s": tuning.accel_noise,
+        "ref_sigma_m": tuning.ref_sigma,
+        "gate_sigmas": tuning.gate_sigmas,
+        "final_gains": a.kf_final.map(|g| json!({"k1_1_s": g.k1, "k2_1_s2": g.k2})),
+        "accepted": kf.counts.accepted,
+        "rejected": kf.counts.rejected,
+        "missing": kf.counts.missing,
+        "reacquired": kf.counts.reacquired,
+        "outages": outage_json(&a.kf_outages, cfg.dt, a.taus[0]),
+    })
+}
+
+/// `summary.json` of the aided mode.
+fn aided_summary(cfg: &VerticalConfig, args: &Args, runs: &AidedRuns, a: &AidedAnalysis) -> Value {
+    let w0_sq = cfg.w0_sq();
+    let (gains, detector, loop_run) = (&runs.gains, &runs.detector, &runs.loop_run);
+    json!({
         "command": "vertical",
         "mode": "aided",
         "inputs": inputs_json(cfg),
-        "reference": {
-            "noise_m": args.ref_noise,
-            "bias_m": args.ref_bias,
-            "outliers": args.ref_outlier.iter().map(|o| json!({"t_s": o.t, "size_m": o.size})).collect::<Vec<_>>(),
-            "outlier_probability": args.ref_outlier_prob,
-            "outlier_size_m": args.ref_outlier_size,
-            "dropouts": args.ref_dropout.iter().map(|d| json!({"start_s": d.start, "duration_s": d.duration})).collect::<Vec<_>>(),
-            "seed": args.seed,
-        },
+        "reference": reference_json(args),
         "w0_rad_s": w0_sq.sqrt(),
         "free_e_fold_time_s": cfg.e_fold_time(),
         "gains": { "k1_1_s": gains.k1, "k2_1_s2": gains.k2 },
         "eigenvalues": eigen_json(&gains.eigenvalues(w0_sq)),
-        "time_constants_s": taus,
-        "steady_state_dh_m": steady,
-        "steady_state_dvh_m_s": steady_v,
+        "time_constants_s": a.taus,
+        "steady_state_dh_m": a.steady.0,
+        "steady_state_dvh_m_s": a.steady.1,
         "settling": {
-            "band_m": band,
-            "measured_s": settling,
-            "theory_s": settling_theory,
+            "band_m": a.band,
+            "measured_s": a.settling.0,
+            "theory_s": a.settling.1,
         },
-        "outages": outage_json(&outs),
+        "outages": outage_json(&a.outages, cfg.dt, a.taus[0]),
         "detector": {
             "enabled": detector.enabled,
             "gate_m": detector.gate,
@@ -489,25 +594,53 @@ fn run_aided(cfg: &VerticalConfig, args: &Args) -> Result<Value> {
             "missing": loop_run.counts.missing,
             "reacquired": loop_run.counts.reacquired,
         },
-        "kalman": {
-            "accel_noise_m_s_sqrt_s": tuning.accel_noise,
-            "ref_sigma_m": tuning.ref_sigma,
-            "gate_sigmas": tuning.gate_sigmas,
-            "final_gains": kf_final.map(|g| json!({"k1_1_s": g.k1, "k2_1_s2": g.k2})),
-            "accepted": kf.counts.accepted,
-            "rejected": kf.counts.rejected,
-            "missing": kf.counts.missing,
-            "reacquired": kf.counts.reacquired,
-            "outages": outage_json(&outs_kf),
-        },
+        "kalman": kalman_json(cfg, runs, a),
         "rms_dh_minus_reference_bias_m": {
             "loop": rms(loop_run.samples.iter().map(|s| s.dh - args.ref_bias)),
-            "kalman": rms(kf.samples.iter().map(|s| s.dh - args.ref_bias)),
+            "kalman": rms(runs.kf.samples.iter().map(|s| s.dh - args.ref_bias)),
         },
         "files": ["vertical.csv", "vertical_kf.csv", "reference.csv", "summary.json", "dh.svg", "dvh.svg"],
-    }))
+    })
 }
 
+/// `--mode aided`: the constant-gain loop and the Kalman variant on one simulated
+/// reference; writes their CSVs, the reference and the plots, and returns the summary.
+fn run_aided(cfg: &VerticalConfig, args: &Args) -> Result<Value> {
+    let gains = aided_gains(cfg, args)?;
+    let grid = cfg.grid();
+    let reference = reference_config(args)
+        .generate(cfg.height, &grid)
+        .map_err(explain)?;
+    let detector = DetectorConfig {
+        enabled: !args.no_fault_detector,
+        gate: args.gate,
+        reacquire: args.reacquire,
+    };
+    let loop_run = simulate_aided(cfg, gains, &reference, detector).map_err(explain)?;
+    let tuning = kalman_tuning(args);
+    // The filter gates on its own innovation sigma (`gate_sigmas`), not on `--gate`.
+    let kf = simulate_kalman(cfg, tuning, &reference, detector).map_err(explain)?;
+    write_samples(&args.out.join("vertical.csv"), &loop_run.samples)?;
+    write_kf(&args.out.join("vertical_kf.csv"), &kf)?;
+    write_reference(
+        &args.out.join("reference.csv"),
+        &grid,
+        &reference,
+        cfg.height,
+    )?;
+    let runs = AidedRuns {
+        gains,
+        detector,
+        tuning,
+        loop_run,
+        kf,
+    };
+    let analysis = analyse(cfg, args, &runs);
+    write_aided_plots(&args.out, cfg, &runs.loop_run, &runs.kf)?;
+    Ok(aided_summary(cfg, args, &runs, &analysis))
+}
+
+/// Root mean square of `xs` (0 for none).
 fn rms(xs: impl Iterator<Item = f64>) -> f64 {
     let (n, s) = xs.fold((0usize, 0.0), |(n, s), x| (n + 1, s + x * x));
     if n == 0 { 0.0 } else { (s / n as f64).sqrt() }

@@ -87,6 +87,10 @@ const SAME_HEIGHT_M: f64 = 100.0;
 /// Numbers of data lines, each with its 1-based line number.
 type Rows = Vec<(u64, Vec<f64>)>;
 
+/// Position rows, each with its 1-based line number and its outlier flag (a CSV's
+/// `outlier` column).
+type FlaggedRows = Vec<(u64, Vec<f64>, Option<bool>)>;
+
 /// The whole text of a small log (a leading UTF-8 byte-order mark dropped).
 fn read_text(path: &Path) -> Result<String, InputError> {
     let text = std::fs::read_to_string(path).map_err(|e| {
@@ -385,6 +389,82 @@ pub struct GnssRecord {
     pub outlier: Option<bool>,
 }
 
+/// A CSV's `outlier` flag of line `n`: 0 or 1 (`None` where the file has no such
+/// column).
+fn outlier_flag(path: &Path, n: u64, x: Option<f64>) -> Result<Option<bool>, InputError> {
+    match x {
+        None => Ok(None),
+        Some(x) if x == 0.0 || x == 1.0 => Ok(Some(x == 1.0)),
+        Some(x) => Err(InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            n,
+            Some(CSV_OUTLIER),
+            format!("the outlier flag is 0 or 1, got {x}"),
+        )),
+    }
+}
+
+/// Rows of a position CSV after its header `h`: the required columns in
+/// [`CSV_POS`] order, and the outlier flag where the header names it.
+fn csv_position_rows<'l>(
+    path: &Path,
+    h: &CsvHeader,
+    lines: impl Iterator<Item = (u64, &'l str)>,
+) -> Result<FlaggedRows, InputError> {
+    let mut cols: Vec<(usize, &str)> = h
+        .require(&CSV_POS, "a GNSS position log", "")?
+        .into_iter()
+        .zip(CSV_POS)
+        .collect();
+    let outlier = h.find(CSV_OUTLIER)?;
+    if let Some(c) = outlier {
+        cols.push((c, CSV_OUTLIER));
+    }
+    let mut out = Vec::new();
+    for (n, mut v) in h.rows(lines, &cols, "")? {
+        let flag = outlier_flag(path, n, outlier.and_then(|_| v.pop()))?;
+        out.push((n, v, flag));
+    }
+    Ok(out)
+}
+
+/// The record of line `n`'s values `v` (`t lat lon h std_n std_e std_d [vn ve vd
+/// std_vn std_ve std_vd]`) after checking the latitude (named `lat_name` in the error).
+fn gnss_record(
+    path: &Path,
+    n: u64,
+    v: &[f64],
+    outlier: Option<bool>,
+    lat_name: &str,
+) -> Result<GnssRecord, InputError> {
+    if !(-90.0..=90.0).contains(&v[1]) {
+        return Err(InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            n,
+            Some(lat_name),
+            format!("latitude {} is outside [-90, 90]", v[1]),
+        ));
+    }
+    let fix = GnssFix {
+        t: v[0],
+        pos: Geodetic::from_degrees(v[1], v[2], v[3]),
+        pos_std: Vector3::new(v[4], v[5], v[6]),
+        vel: (v.len() == 13).then(|| {
+            (
+                Vector3::new(v[7], v[8], v[9]),
+                Vector3::new(v[10], v[11], v[12]),
+            )
+        }),
+    };
+    Ok(GnssRecord {
+        line: n,
+        fix,
+        outlier,
+    })
+}
+
 /// Read a GNSS position log (KF-GINS text, 7 or 13 columns, or CSV with a header; see
 /// the module doc) with each fix's line and outlier flag.
 pub fn read_gnss_records(path: &Path) -> Result<Vec<GnssRecord>, InputError> {
@@ -411,65 +491,11 @@ pub fn read_gnss_records(path: &Path) -> Result<Vec<GnssRecord>, InputError> {
                 "lat",
             )
         }
-        Some(h) => {
-            let mut cols: Vec<(usize, &str)> = h
-                .require(&CSV_POS, "a GNSS position log", "")?
-                .into_iter()
-                .zip(CSV_POS)
-                .collect();
-            let outlier = h.find(CSV_OUTLIER)?;
-            if let Some(c) = outlier {
-                cols.push((c, CSV_OUTLIER));
-            }
-            let mut out = Vec::new();
-            for (n, mut v) in h.rows(lines, &cols, "")? {
-                let flag = match outlier.and_then(|_| v.pop()) {
-                    None => None,
-                    Some(x) if x == 0.0 || x == 1.0 => Some(x == 1.0),
-                    Some(x) => {
-                        return Err(InputError::new(
-                            InputErrorKind::NotANumber,
-                            path,
-                            n,
-                            Some(CSV_OUTLIER),
-                            format!("the outlier flag is 0 or 1, got {x}"),
-                        ));
-                    }
-                };
-                out.push((n, v, flag));
-            }
-            (out, "lat_deg")
-        }
+        Some(h) => (csv_position_rows(path, h, lines)?, "lat_deg"),
     };
-    let mut records = Vec::with_capacity(rows.len());
-    for (n, v, outlier) in rows {
-        if !(-90.0..=90.0).contains(&v[1]) {
-            return Err(InputError::new(
-                InputErrorKind::NotANumber,
-                path,
-                n,
-                Some(lat_name),
-                format!("latitude {} is outside [-90, 90]", v[1]),
-            ));
-        }
-        let fix = GnssFix {
-            t: v[0],
-            pos: Geodetic::from_degrees(v[1], v[2], v[3]),
-            pos_std: Vector3::new(v[4], v[5], v[6]),
-            vel: (v.len() == 13).then(|| {
-                (
-                    Vector3::new(v[7], v[8], v[9]),
-                    Vector3::new(v[10], v[11], v[12]),
-                )
-            }),
-        };
-        records.push(GnssRecord {
-            line: n,
-            fix,
-            outlier,
-        });
-    }
-    Ok(records)
+    rows.into_iter()
+        .map(|(n, v, outlier)| gnss_record(path, n, &v, outlier, lat_name))
+        .collect()
 }
 
 /// Read a GNSS position log (KF-GINS text, 7 or 13 columns, or CSV with a header; see

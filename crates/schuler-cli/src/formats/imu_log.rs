@@ -248,6 +248,68 @@ enum Columns {
     },
 }
 
+/// The column names of a CSV header line: each trimmed of blanks and of one pair of
+/// double quotes.
+fn header_names(line: &[u8]) -> Vec<String> {
+    line.split(|&b| b == b',')
+        .map(|raw| {
+            let text = String::from_utf8_lossy(raw);
+            let text = text.trim_matches([' ', '\t']);
+            let text = text
+                .strip_prefix('"')
+                .and_then(|s| s.strip_suffix('"'))
+                .unwrap_or(text);
+            text.trim().to_owned()
+        })
+        .collect()
+}
+
+/// The columns of `names` that are `wanted` (ASCII case-insensitive; `t` also as
+/// `time`, where no column is named `t`).
+fn columns_named(names: &[String], wanted: &str) -> Vec<usize> {
+    let aliases: &[&str] = if wanted == "t" {
+        &["t", "time"]
+    } else {
+        &[wanted]
+    };
+    aliases
+        .iter()
+        .map(|alias| {
+            (0..names.len())
+                .filter(|&i| names[i].eq_ignore_ascii_case(alias))
+                .collect::<Vec<_>>()
+        })
+        .find(|found| !found.is_empty())
+        .unwrap_or_default()
+}
+
+/// The layout of a header `names`: `given`, or else the one whose columns it names
+/// (all, or more of them); with its column names and those the header lacks.
+fn choose_layout(
+    names: &[String],
+    given: Option<ImuLayout>,
+) -> (ImuLayout, &'static [&'static str; 7], Vec<&'static str>) {
+    let missing = |all: &[&'static str; 7]| -> Vec<&'static str> {
+        all.iter()
+            .copied()
+            .filter(|n| columns_named(names, n).is_empty())
+            .collect()
+    };
+    let missing_inc = missing(&INCREMENT_NAMES);
+    let missing_rate = missing(&RATE_NAMES);
+    let chosen = match given {
+        Some(l) => l,
+        None if missing_inc.is_empty() => ImuLayout::Increments,
+        None if missing_rate.is_empty() => ImuLayout::Rates,
+        None if missing_rate.len() < missing_inc.len() => ImuLayout::Rates,
+        None => ImuLayout::Increments,
+    };
+    match chosen {
+        ImuLayout::Increments => (chosen, &INCREMENT_NAMES, missing_inc),
+        ImuLayout::Rates => (chosen, &RATE_NAMES, missing_rate),
+    }
+}
+
 /// A field-level parse failure, before the file and names are attached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum FieldError {
@@ -693,77 +755,65 @@ impl<R: BufRead> ImuReader<R> {
     /// Parses the current line as the CSV header.
     fn read_header(&mut self, layout: Option<ImuLayout>) -> Result<(), InputError> {
         let line_no = self.lines.line_no();
-        let line = self.lines.line();
-        let names: Vec<String> = line
-            .split(|&b| b == b',')
-            .map(|raw| {
-                let text = String::from_utf8_lossy(raw);
-                let text = text.trim_matches([' ', '\t']);
-                let text = text
-                    .strip_prefix('"')
-                    .and_then(|s| s.strip_suffix('"'))
-                    .unwrap_or(text);
-                text.trim().to_owned()
-            })
-            .collect();
-        let find = |wanted: &str| -> Vec<usize> {
-            let aliases: &[&str] = if wanted == "t" {
-                &["t", "time"]
-            } else {
-                &[wanted]
-            };
-            aliases
-                .iter()
-                .map(|alias| {
-                    (0..names.len())
-                        .filter(|&i| names[i].eq_ignore_ascii_case(alias))
-                        .collect::<Vec<_>>()
-                })
-                .find(|found| !found.is_empty())
-                .unwrap_or_default()
-        };
-        let missing = |all: &[&'static str; 7]| -> Vec<&'static str> {
-            all.iter().copied().filter(|n| find(n).is_empty()).collect()
-        };
-        let missing_inc = missing(&INCREMENT_NAMES);
-        let missing_rate = missing(&RATE_NAMES);
-        let chosen = match layout {
-            Some(l) => l,
-            None if missing_inc.is_empty() => ImuLayout::Increments,
-            None if missing_rate.is_empty() => ImuLayout::Rates,
-            None if missing_rate.len() < missing_inc.len() => ImuLayout::Rates,
-            None => ImuLayout::Increments,
-        };
-        let (set, missing) = match chosen {
-            ImuLayout::Increments => (&INCREMENT_NAMES, missing_inc),
-            ImuLayout::Rates => (&RATE_NAMES, missing_rate),
-        };
+        let names = header_names(self.lines.line());
+        let (chosen, set, missing) = choose_layout(&names, layout);
         if !missing.is_empty() {
-            let detected = if self.csv_auto_detected {
-                "; this line was taken for a CSV header because its first field is not a number"
-            } else {
-                ""
-            };
-            let also = if layout.is_none() {
-                " (a CSV IMU log needs t (or time) and either dtheta_x, dtheta_y, dtheta_z, \
-                 dvel_x, dvel_y, dvel_z or w_x, w_y, w_z, f_x, f_y, f_z)"
-            } else {
-                ""
-            };
-            return Err(self.error(
-                InputErrorKind::Header,
-                line_no,
-                None,
-                format!(
-                    "header lacks column(s) {} for {chosen}{also}{detected}",
-                    missing.join(", ")
-                ),
-            ));
+            return Err(self.missing_columns(line_no, chosen, &missing, layout.is_none()));
         }
+        let (slot_of_col, time_col) = self.slots(line_no, &names, set)?;
+        self.layout = chosen;
+        self.columns = Columns::Csv {
+            slot_of_col,
+            names,
+            time_col,
+        };
+        Ok(())
+    }
+
+    /// The error of a header at `line_no` that lacks the columns `missing` of the
+    /// layout `chosen` (`guessed`: the layout was not given, so both sets are named).
+    fn missing_columns(
+        &self,
+        line_no: u64,
+        chosen: ImuLayout,
+        missing: &[&str],
+        guessed: bool,
+    ) -> InputError {
+        let detected = if self.csv_auto_detected {
+            "; this line was taken for a CSV header because its first field is not a number"
+        } else {
+            ""
+        };
+        let also = if guessed {
+            " (a CSV IMU log needs t (or time) and either dtheta_x, dtheta_y, dtheta_z, \
+             dvel_x, dvel_y, dvel_z or w_x, w_y, w_z, f_x, f_y, f_z)"
+        } else {
+            ""
+        };
+        self.error(
+            InputErrorKind::Header,
+            line_no,
+            None,
+            format!(
+                "header lacks column(s) {} for {chosen}{also}{detected}",
+                missing.join(", ")
+            ),
+        )
+    }
+
+    /// For each column of the header `names` (line `line_no`), the slot of `set` it
+    /// holds ([`UNUSED`] for none), and the time's column; every name of `set` must
+    /// appear exactly once.
+    fn slots(
+        &self,
+        line_no: u64,
+        names: &[String],
+        set: &[&str; 7],
+    ) -> Result<(Vec<u8>, usize), InputError> {
         let mut slot_of_col = vec![UNUSED; names.len()];
         let mut time_col = 0;
         for (slot, name) in set.iter().enumerate() {
-            let found = find(name);
+            let found = columns_named(names, name);
             if let [first, second, ..] = found[..] {
                 return Err(self.error(
                     InputErrorKind::Header,
@@ -776,7 +826,7 @@ impl<R: BufRead> ImuReader<R> {
                     ),
                 ));
             }
-            // `missing` is empty, so every name was found exactly once here.
+            // The caller checked that no name is missing, so it was found exactly once.
             let col = found[0];
             if slot == 0 {
                 time_col = col;
@@ -784,13 +834,7 @@ impl<R: BufRead> ImuReader<R> {
             // `slot` < 7 fits a u8.
             slot_of_col[col] = slot as u8;
         }
-        self.layout = chosen;
-        self.columns = Columns::Csv {
-            slot_of_col,
-            names,
-            time_col,
-        };
-        Ok(())
+        Ok((slot_of_col, time_col))
     }
 
     /// Name of column `col` (0-based) for messages.
@@ -1224,77 +1268,53 @@ mod tests {
         assert_eq!(e.path, Path::new(PATH));
     }
 
+    /// Two good lines under a comment: a bad third data line is line 4.
+    const GOOD_HEAD: &str = "# header\n1 0 0 0 0 0 0\n2 0 0 0 0 0 0\n";
+
+    /// Each kind of bad text line, after [`GOOD_HEAD`], names line 4, its field and
+    /// what is wrong.
     #[test]
     fn bad_text_lines_name_line_and_field() {
-        let head = "# header\n1 0 0 0 0 0 0\n2 0 0 0 0 0 0\n";
+        use InputErrorKind::{ColumnCount, NotANumber, NotFinite, TimeNotIncreasing};
         let cases: [(&str, Option<&str>, InputErrorKind, &str); 10] = [
             (
                 "3 0 0 0 0",
                 None,
-                InputErrorKind::ColumnCount,
+                ColumnCount,
                 "expected 7 columns, found 5",
             ),
-            (
-                "3 0 0 0 0 0 0 9",
-                None,
-                InputErrorKind::ColumnCount,
-                "found 8",
-            ),
-            (
-                "3 0 0 0 0 abc 0",
-                Some("dvel_y"),
-                InputErrorKind::NotANumber,
-                "\"abc\"",
-            ),
-            (
-                "3 0 0 0 0 1.2.3 0",
-                Some("dvel_y"),
-                InputErrorKind::NotANumber,
-                "\"1.2.3\"",
-            ),
-            (
-                "3,0,,0,0,0,0",
-                Some("dtheta_y"),
-                InputErrorKind::NotANumber,
-                "empty field",
-            ),
-            (
-                "3 0 0 NaN 0 0 0",
-                Some("dtheta_z"),
-                InputErrorKind::NotFinite,
-                "\"NaN\"",
-            ),
-            (
-                "3 0 0 0 -inf 0 0",
-                Some("dvel_x"),
-                InputErrorKind::NotFinite,
-                "\"-inf\"",
-            ),
+            ("3 0 0 0 0 0 0 9", None, ColumnCount, "found 8"),
+            ("3 0 0 0 0 abc 0", Some("dvel_y"), NotANumber, "\"abc\""),
+            ("3 0 0 0 0 1.2.3 0", Some("dvel_y"), NotANumber, "\"1.2.3\""),
+            ("3,0,,0,0,0,0", Some("dtheta_y"), NotANumber, "empty field"),
+            ("3 0 0 NaN 0 0 0", Some("dtheta_z"), NotFinite, "\"NaN\""),
+            ("3 0 0 0 -inf 0 0", Some("dvel_x"), NotFinite, "\"-inf\""),
             (
                 "3 1e999 0 0 0 0 0",
                 Some("dtheta_x"),
-                InputErrorKind::NotFinite,
+                NotFinite,
                 "\"1e999\"",
             ),
-            (
-                "x3 0 0 0 0 0 0",
-                Some("t"),
-                InputErrorKind::NotANumber,
-                "\"x3\"",
-            ),
+            ("x3 0 0 0 0 0 0", Some("t"), NotANumber, "\"x3\""),
             (
                 "1.5 0 0 0 0 0 0",
                 Some("t"),
-                InputErrorKind::TimeNotIncreasing,
+                TimeNotIncreasing,
                 "t = 1.5 after t = 2 at line 3",
             ),
         ];
         for (bad, field, kind, msg) in cases {
-            let input = format!("{head}{bad}\n5 0 0 0 0 0 0\n");
+            let input = format!("{GOOD_HEAD}{bad}\n5 0 0 0 0 0 0\n");
             let e = read_err(&input, &text());
             assert_err(&e, 4, field, kind, msg);
         }
-        let e = read_err(&format!("{head}2 0 0 0 0 0 0\n"), &text());
+    }
+
+    /// A time repeated from the line before names that line; the whole message reads
+    /// `file:line: field NAME: ...`.
+    #[test]
+    fn a_repeated_time_names_the_earlier_line_and_the_message_reads_whole() {
+        let e = read_err(&format!("{GOOD_HEAD}2 0 0 0 0 0 0\n"), &text());
         assert_err(
             &e,
             4,
@@ -1302,7 +1322,7 @@ mod tests {
             InputErrorKind::TimeNotIncreasing,
             "t = 2 also at line 3",
         );
-        let e = read_err(&format!("{head}3 0 0 0 0 abc 0\n"), &text());
+        let e = read_err(&format!("{GOOD_HEAD}3 0 0 0 0 abc 0\n"), &text());
         assert_eq!(
             e.to_string(),
             r#"IMU.txt:4: field dvel_y: not a number: "abc""#

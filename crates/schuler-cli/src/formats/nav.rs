@@ -61,20 +61,152 @@ const CSV_FIELDS: [&str; 10] = [
     "yaw_deg",
 ];
 
+/// Names of the values a data line gives, in [`NavRecord`] order, as a KF-GINS
+/// line's errors name them.
+const KF_GINS_VALUES: [&str; 10] = [
+    "sow", "lat", "lon", "h", "vn", "ve", "vd", "roll", "pitch", "yaw",
+];
+
+/// The error of a file that cannot be opened or read.
+fn cannot_read(path: &Path, e: std::io::Error) -> InputError {
+    InputError::new(
+        InputErrorKind::Io,
+        path,
+        0,
+        None,
+        format!("cannot read: {e}"),
+    )
+}
+
+/// Field `field` of line `n` parsed from `text`: a finite number.
+fn number(path: &Path, n: u64, field: &str, text: &str) -> Result<f64, InputError> {
+    let at = |kind, msg: String| InputError::new(kind, path, n, Some(field), msg);
+    let x: f64 = text.parse().map_err(|_| {
+        at(
+            InputErrorKind::NotANumber,
+            format!("not a number: {}", quote_field(text.as_bytes())),
+        )
+    })?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(at(
+            InputErrorKind::NotFinite,
+            format!("not finite: {}", quote_field(text.as_bytes())),
+        ))
+    }
+}
+
+/// The values of KF-GINS line `n` (time, lat, lon [deg], h, vn, ve, vd, roll, pitch,
+/// yaw [deg]): 11 columns, a whole week >= 0, the time of week continued from the
+/// file's `first_week` (set by its first line).
+fn kf_gins_values(
+    path: &Path,
+    n: u64,
+    l: &str,
+    first_week: &mut Option<f64>,
+) -> Result<[f64; 10], InputError> {
+    let fields: Vec<&str> = l
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|f| !f.is_empty())
+        .collect();
+    if fields.len() != KF_GINS_FIELDS.len() {
+        return Err(InputError::new(
+            InputErrorKind::ColumnCount,
+            path,
+            n,
+            None,
+            format!(
+                "{} columns, expected 11 (week sow lat lon h vn ve vd roll pitch yaw)",
+                fields.len()
+            ),
+        ));
+    }
+    let mut x = [0.0; 11];
+    for (k, f) in fields.iter().enumerate() {
+        x[k] = number(path, n, KF_GINS_FIELDS[k], f)?;
+    }
+    let week = x[0];
+    if week < 0.0 || week.fract() != 0.0 {
+        return Err(InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            n,
+            Some("week"),
+            format!("a GPS week is a whole number >= 0, got {}", fields[0]),
+        ));
+    }
+    let week0 = *first_week.get_or_insert(week);
+    let mut v = [0.0; 10];
+    v[0] = x[1] + (week - week0) * WEEK_S;
+    v[1..].copy_from_slice(&x[2..]);
+    Ok(v)
+}
+
+/// The values of CSV line `n` in [`CSV_FIELDS`] order, from a line with as many
+/// fields as the header names (`columns`: that count and where each of them is).
+fn csv_values(
+    path: &Path,
+    n: u64,
+    l: &str,
+    columns: &(usize, [usize; 10]),
+) -> Result<[f64; 10], InputError> {
+    let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+    if fields.len() != columns.0 {
+        return Err(InputError::new(
+            InputErrorKind::ColumnCount,
+            path,
+            n,
+            None,
+            format!("{} columns, the header names {}", fields.len(), columns.0),
+        ));
+    }
+    let mut v = [0.0; 10];
+    for (k, &i) in columns.1.iter().enumerate() {
+        v[k] = number(path, n, CSV_FIELDS[k], fields[i])?;
+    }
+    Ok(v)
+}
+
+/// The record of line `n`'s values `v` after checking the latitude range and that the
+/// time comes after `prev`'s; `names` name the values in errors.
+fn record(
+    path: &Path,
+    n: u64,
+    v: [f64; 10],
+    names: &[&str; 10],
+    prev: Option<&NavRecord>,
+) -> Result<NavRecord, InputError> {
+    let at = |field: &str, kind, msg: String| InputError::new(kind, path, n, Some(field), msg);
+    if !(-90.0..=90.0).contains(&v[1]) {
+        return Err(at(
+            names[1],
+            InputErrorKind::NotANumber,
+            format!("latitude {} is outside [-90, 90]", v[1]),
+        ));
+    }
+    if let Some(prev) = prev
+        && v[0] <= prev.t_sow
+    {
+        return Err(at(
+            names[0],
+            InputErrorKind::TimeNotIncreasing,
+            format!("time {} does not increase (previous {})", v[0], prev.t_sow),
+        ));
+    }
+    Ok(NavRecord {
+        t_sow: v[0],
+        pos: Geodetic::from_degrees(v[1], v[2], v[3]),
+        v_n: Vector3::new(v[4], v[5], v[6]),
+        att: Euler::from_degrees(v[7], v[8], v[9]),
+    })
+}
+
 /// Reads a navigation file whole (either layout, told by its first data line),
 /// checking column counts, numbers, finiteness, latitude range, whole weeks and
 /// strictly increasing time; errors name the file, line and field.
 pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> {
-    let io_err = |e: std::io::Error| {
-        InputError::new(
-            InputErrorKind::Io,
-            path,
-            0,
-            None,
-            format!("cannot read: {e}"),
-        )
-    };
-    let file = std::fs::File::open(path).map_err(io_err)?;
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, e))?;
     let mut reader = BufReader::with_capacity(1 << 20, file);
     let mut buf: Vec<u8> = Vec::new();
     let mut n: u64 = 0;
@@ -85,7 +217,11 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
     let mut rows: Vec<NavRecord> = Vec::new();
     loop {
         buf.clear();
-        if reader.read_until(b'\n', &mut buf).map_err(io_err)? == 0 {
+        if reader
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| cannot_read(path, e))?
+            == 0
+        {
             break;
         }
         n += 1;
@@ -99,122 +235,22 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
         }
         let fmt = match format {
             Some(f) => f,
-            None => {
-                let f = if l.starts_with(|c: char| c.is_ascii_alphabetic() || c == '"') {
-                    csv_columns = csv_header(path, n, l)?;
-                    NavFormat::Csv
-                } else {
-                    NavFormat::KfGins
-                };
-                format = Some(f);
-                if f == NavFormat::Csv {
-                    continue;
-                }
-                f
+            None if l.starts_with(|c: char| c.is_ascii_alphabetic() || c == '"') => {
+                csv_columns = csv_header(path, n, l)?;
+                format = Some(NavFormat::Csv);
+                continue;
             }
+            None => *format.insert(NavFormat::KfGins),
         };
-        let at = |field: &str, kind, msg: String| InputError::new(kind, path, n, Some(field), msg);
-        let number = |field: &str, text: &str| -> Result<f64, InputError> {
-            let x: f64 = text.parse().map_err(|_| {
-                at(
-                    field,
-                    InputErrorKind::NotANumber,
-                    format!("not a number: {}", quote_field(text.as_bytes())),
-                )
-            })?;
-            if x.is_finite() {
-                Ok(x)
-            } else {
-                Err(at(
-                    field,
-                    InputErrorKind::NotFinite,
-                    format!("not finite: {}", quote_field(text.as_bytes())),
-                ))
-            }
+        let (v, names) = match fmt {
+            NavFormat::KfGins => (
+                kf_gins_values(path, n, l, &mut first_week)?,
+                &KF_GINS_VALUES,
+            ),
+            NavFormat::Csv => (csv_values(path, n, l, &csv_columns)?, &CSV_FIELDS),
         };
-        // v: time, lat, lon [deg], h, vn, ve, vd, roll, pitch, yaw [deg].
-        let mut v = [0.0; 10];
-        let names: [&str; 10];
-        match fmt {
-            NavFormat::KfGins => {
-                let fields: Vec<&str> = l
-                    .split(|c: char| c.is_whitespace() || c == ',')
-                    .filter(|f| !f.is_empty())
-                    .collect();
-                if fields.len() != KF_GINS_FIELDS.len() {
-                    return Err(InputError::new(
-                        InputErrorKind::ColumnCount,
-                        path,
-                        n,
-                        None,
-                        format!(
-                            "{} columns, expected 11 (week sow lat lon h vn ve vd roll pitch yaw)",
-                            fields.len()
-                        ),
-                    ));
-                }
-                let mut x = [0.0; 11];
-                for (k, f) in fields.iter().enumerate() {
-                    x[k] = number(KF_GINS_FIELDS[k], f)?;
-                }
-                let week = x[0];
-                if week < 0.0 || week.fract() != 0.0 {
-                    return Err(at(
-                        "week",
-                        InputErrorKind::NotANumber,
-                        format!("a GPS week is a whole number >= 0, got {}", fields[0]),
-                    ));
-                }
-                let week0 = *first_week.get_or_insert(week);
-                v[0] = x[1] + (week - week0) * WEEK_S;
-                v[1..].copy_from_slice(&x[2..]);
-                names = [
-                    "sow", "lat", "lon", "h", "vn", "ve", "vd", "roll", "pitch", "yaw",
-                ];
-            }
-            NavFormat::Csv => {
-                let fields: Vec<&str> = l.split(',').map(str::trim).collect();
-                if fields.len() != csv_columns.0 {
-                    return Err(InputError::new(
-                        InputErrorKind::ColumnCount,
-                        path,
-                        n,
-                        None,
-                        format!(
-                            "{} columns, the header names {}",
-                            fields.len(),
-                            csv_columns.0
-                        ),
-                    ));
-                }
-                for (k, &i) in csv_columns.1.iter().enumerate() {
-                    v[k] = number(CSV_FIELDS[k], fields[i])?;
-                }
-                names = CSV_FIELDS;
-            }
-        }
-        if !(-90.0..=90.0).contains(&v[1]) {
-            return Err(at(
-                names[1],
-                InputErrorKind::NotANumber,
-                format!("latitude {} is outside [-90, 90]", v[1]),
-            ));
-        }
-        if let Some(prev) = rows.last()
-            && v[0] <= prev.t_sow
-        {
-            return Err(at(
-                names[0],
-                InputErrorKind::TimeNotIncreasing,
-                format!("time {} does not increase (previous {})", v[0], prev.t_sow),
-            ));
-        }
-        rows.push(NavRecord {
-            t_sow: v[0],
-            pos: Geodetic::from_degrees(v[1], v[2], v[3]),
-            v_n: Vector3::new(v[4], v[5], v[6]),
-            att: Euler::from_degrees(v[7], v[8], v[9]),
-        });
+        let r = record(path, n, v, names, rows.last())?;
+        rows.push(r);
     }
     match format {
         Some(f) if !rows.is_empty() => Ok((f, rows)),

@@ -26,6 +26,7 @@ use anyhow::{Context, Result};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, Alignment, align};
+use schuler::channel::vertical::Gains;
 use schuler::earth::Wgs84;
 use schuler::filter::ImuNoise;
 use schuler::session::MechanizationChoice;
@@ -121,35 +122,34 @@ fn align_both(rec: &capture::Recording, s: &Sortie) -> Result<Alignments> {
     Ok(Alignments { fine, coarse_only })
 }
 
-/// `schuler demo`.
-pub fn run(args: DemoArgs) -> Result<()> {
-    let started = Instant::now();
-    let sortie = if args.quick {
-        Sortie::quick()?
-    } else {
-        Sortie::full()?
-    };
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
-
+/// The sortie simulated in memory; returns the recording, the trajectory's span [s]
+/// and the wall-clock time it took [s].
+fn simulate(sortie: &Sortie, multi: &MultiProgress) -> Result<(capture::Recording, f64, f64)> {
     let clock = Instant::now();
     let (traj, _) = sortie.spec.trajectory(Wgs84).context("the sortie")?;
     let span = traj.end() - traj.start();
-    let rec = capture::record(&sortie.spec, bar(&multi, "simulate", span as u64))?;
-    let simulate_s = clock.elapsed().as_secs_f64();
+    let rec = capture::record(&sortie.spec, bar(multi, "simulate", span as u64))?;
+    Ok((rec, span, clock.elapsed().as_secs_f64()))
+}
 
+/// Both alignments on the pad ([`align_both`]) behind a progress bar; returns them and
+/// the wall-clock time they took [s].
+fn align_timed(
+    rec: &capture::Recording,
+    sortie: &Sortie,
+    multi: &MultiProgress,
+) -> Result<(Alignments, f64)> {
     let clock = Instant::now();
-    let align_bar = bar(&multi, "align (coarse, fine)", 2);
-    let alignments = align_both(&rec, &sortie)?;
+    let align_bar = bar(multi, "align (coarse, fine)", 2);
+    let alignments = align_both(rec, sortie)?;
     align_bar.inc(2);
     align_bar.finish();
-    let align_s = clock.elapsed().as_secs_f64();
+    Ok((alignments, clock.elapsed().as_secs_f64()))
+}
 
-    let fine_start = modes::Start::from_alignment(&alignments.fine);
-    let coarse_start = modes::Start::from_alignment(&alignments.coarse_only);
-    let gains = modes::baro_gains(&fine_start.state)?;
-    let flight = (span - sortie.nav_start()) as u64;
+/// The inertial-satellite mode's settings: the scenario's GNSS lever arm, the
+/// barometer's noise and its bias prior.
+fn aided_settings(sortie: &Sortie) -> Result<modes::AidedSettings> {
     let gnss = sortie.spec.gnss.as_ref().context("the sortie has GNSS")?;
     let lever = gnss
         .lever_arm
@@ -160,34 +160,49 @@ pub fn run(args: DemoArgs) -> Result<()> {
         })
         .transpose()?
         .unwrap_or_default();
-    let aided_settings = modes::AidedSettings {
+    Ok(modes::AidedSettings {
         lever_arm: lever,
         baro_std: 0.5,
         baro_bias: (10.0, 0.05),
-    };
+    })
+}
+
+/// The sortie's five runs, navigated in parallel over the `flight` seconds after the
+/// alignment: the filter (forward and smoothed) and the inertial mode with the baro
+/// loop, after coarse alignment alone, and without the baro loop.
+fn navigate_sortie(
+    rec: &capture::Recording,
+    alignments: &Alignments,
+    gains: Gains,
+    aided_settings: &modes::AidedSettings,
+    multi: &MultiProgress,
+    flight: u64,
+) -> Vec<ModeRun> {
+    let fine_start = modes::Start::from_alignment(&alignments.fine);
+    let coarse_start = modes::Start::from_alignment(&alignments.coarse_only);
     let bars = [
-        bar(&multi, "inertial-satellite (KF)", flight),
-        bar(&multi, "inertial, baro loop", flight),
-        bar(&multi, "inertial, coarse only", flight),
-        bar(&multi, "inertial, no baro", flight),
+        bar(multi, "inertial-satellite (KF)", flight),
+        bar(multi, "inertial, baro loop", flight),
+        bar(multi, "inertial, coarse only", flight),
+        bar(multi, "inertial, no baro", flight),
     ];
     let ((forward, smoothed), inertial, coarse_only, no_baro) = std::thread::scope(|scope| {
         let aided = scope.spawn(|| {
             modes::aided(
-                &rec,
+                rec,
                 &fine_start,
                 &modes::Prior::from_alignment(
                     &alignments.fine,
                     Vector3::repeat(modes::PAD_SURVEY_STD),
                 ),
-                &aided_settings,
+                aided_settings,
                 MechanizationChoice::Ned,
                 &bars[0],
             )
         });
-        let inertial = modes::inertial(&rec, &fine_start, Some(gains), NED, &bars[1]);
-        let coarse_only = modes::inertial(&rec, &coarse_start, Some(gains), NED, &bars[2]);
-        let no_baro = modes::inertial(&rec, &fine_start, None, NED, &bars[3]);
+        let inertial = modes::inertial(rec, &fine_start, Some(gains), NED, &bars[1]);
+        let coarse_only = modes::inertial(rec, &coarse_start, Some(gains), NED, &bars[2]);
+        let no_baro = modes::inertial(rec, &fine_start, None, NED, &bars[3]);
         let aided = aided
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
@@ -196,7 +211,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     for b in &bars {
         b.finish();
     }
-    let runs: Vec<ModeRun> = [
+    [
         (
             "inertial_coarse",
             "inertial after coarse alignment only",
@@ -212,16 +227,34 @@ pub fn run(args: DemoArgs) -> Result<()> {
         ("smoothed", "inertial-satellite smoothed", smoothed),
     ]
     .into_iter()
-    .map(|(key, label, track)| ModeRun::new(key, label, track, |t| errors::errors(t, &rec)))
-    .collect();
+    .map(|(key, label, track)| ModeRun::new(key, label, track, |t| errors::errors(t, rec)))
+    .collect()
+}
+
+/// `schuler demo`.
+pub fn run(args: DemoArgs) -> Result<()> {
+    let started = Instant::now();
+    let sortie = if args.quick {
+        Sortie::quick()?
+    } else {
+        Sortie::full()?
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
+    let (rec, span, simulate_s) = simulate(&sortie, &multi)?;
+    let (alignments, align_s) = align_timed(&rec, &sortie, &multi)?;
+    let gains = modes::baro_gains(&modes::Start::from_alignment(&alignments.fine).state)?;
+    let settings = aided_settings(&sortie)?;
+    let flight = (span - sortie.nav_start()) as u64;
+    let runs = navigate_sortie(&rec, &alignments, gains, &settings, &multi, flight);
 
     let crossing = if args.quick {
         crossing::Crossing::quick(&sortie)?
     } else {
         crossing::Crossing::full(&sortie)?
     };
-    let polar = polar::run(crossing, &aided_settings, &multi)?;
-
+    let polar = polar::run(crossing, &settings, &multi)?;
     let timing = page::Timing {
         simulate: simulate_s,
         align: align_s,

@@ -2,14 +2,15 @@
 //! with everything embedded. Numbers in the report's tables are the strings written
 //! to the CSVs (one formatter for both), so the report and the data never disagree.
 
-use super::capture::Recording;
+use super::capture::{Recording, TruthEpoch};
 use super::errors::{self, height};
-use super::modes::{BARO_LOOP_TAU, Track};
+use super::modes::{BARO_LOOP_TAU, SensorEpoch, Track};
 use super::polar::Polar;
 use super::{Alignments, ModeRun, Sortie, page_polar};
 use crate::plot::{LineStyle, Plot};
 use crate::report::{Report, Table};
 use anyhow::{Context, Result};
+use nalgebra::Vector3;
 use schuler::analysis::errors::EpochErrors;
 use schuler::channel::vertical::Gains;
 use schuler::units::{DEG_PER_H, UG};
@@ -189,15 +190,44 @@ pub(super) fn find<'a>(runs: &'a [ModeRun], key: &str) -> Result<&'a ModeRun> {
         .with_context(|| format!("no {key} run"))
 }
 
-/// Sensor estimates, truth and 3σ per axis: `sensors.csv` and six plots.
-fn sensors(dir: &Path, report: &mut Report, rec: &Recording, track: &Track) -> Result<()> {
+/// An instrument triad of the sensor outputs.
+#[derive(Debug, Clone, Copy)]
+enum Triad {
+    /// Gyro drift [deg/h].
+    Gyros,
+    /// Accelerometer bias [ug].
+    Accelerometers,
+}
+
+impl Triad {
+    /// Both, in the CSV's order.
+    const ALL: [Triad; 2] = [Triad::Gyros, Triad::Accelerometers];
+
+    /// File and axis-label stem, plot title stem, display unit [SI] and its label.
+    fn names(self) -> (&'static str, &'static str, f64, &'static str) {
+        match self {
+            Triad::Gyros => ("gyro", "Gyro drift", DEG_PER_H, "deg/h"),
+            Triad::Accelerometers => ("accel", "Accelerometer bias", UG, "ug"),
+        }
+    }
+
+    /// The filter's estimate and standard deviation in `x`, and the truth in `tr` [SI].
+    fn values(self, x: &SensorEpoch, tr: &TruthEpoch) -> [Vector3<f64>; 3] {
+        match self {
+            Triad::Gyros => [x.est.gyro_bias, x.gyro_std, tr.gyro_bias],
+            Triad::Accelerometers => [x.est.accel_bias, x.accel_std, tr.accel_bias],
+        }
+    }
+}
+
+/// `sensors.csv`: once a second, each axis's estimate, standard deviation and truth.
+fn sensors_csv(dir: &Path, rec: &Recording, track: &Track) -> Result<()> {
     let rows = track.sensors.iter().map(|x| {
         let tr = rec.truth_at(x.t);
         let mut row = format!("{:.0}", x.t);
-        for (est, sd, truth, unit) in [
-            (x.est.gyro_bias, x.gyro_std, tr.gyro_bias, DEG_PER_H),
-            (x.est.accel_bias, x.accel_std, tr.accel_bias, UG),
-        ] {
+        for k in Triad::ALL {
+            let (_, _, unit, _) = k.names();
+            let [est, sd, truth] = k.values(x, tr);
             for i in 0..3 {
                 let _ = write!(
                     row,
@@ -217,7 +247,36 @@ fn sensors(dir: &Path, report: &mut Report, rec: &Recording, track: &Track) -> R
          gz_est_deg_h,gz_std_deg_h,gz_true_deg_h,ax_est_ug,ax_std_ug,ax_true_ug,\
          ay_est_ug,ay_std_ug,ay_true_ug,az_est_ug,az_std_ug,az_true_ug",
         rows,
-    )?;
+    )
+}
+
+/// Axis `i` of the triad `k`: the estimate, the truth and the estimate ± 3σ.
+fn sensor_plot(rec: &Recording, track: &Track, k: Triad, i: usize, axis: &str) -> Plot {
+    let (name, what, unit, label) = k.names();
+    let t: Vec<f64> = track.sensors.iter().map(|x| x.t).collect();
+    let [est, sd, truth]: [Vec<f64>; 3] = std::array::from_fn(|j| {
+        track
+            .sensors
+            .iter()
+            .map(|x| k.values(x, rec.truth_at(x.t))[j][i] / unit)
+            .collect()
+    });
+    let hi: Vec<f64> = est.iter().zip(&sd).map(|(e, s)| e + 3.0 * s).collect();
+    let lo: Vec<f64> = est.iter().zip(&sd).map(|(e, s)| e - 3.0 * s).collect();
+    Plot::new(
+        &format!("{what}, {axis} axis"),
+        "t [s]",
+        &format!("{name}_{axis} [{label}]"),
+    )
+    .line("estimate", &t, &est, LineStyle::Solid)
+    .line("truth", &t, &truth, LineStyle::Dashed)
+    .line("estimate + 3 sigma", &t, &hi, LineStyle::Dotted)
+    .line("estimate - 3 sigma", &t, &lo, LineStyle::Dotted)
+}
+
+/// Sensor estimates, truth and 3σ per axis: `sensors.csv` and six plots.
+fn sensors(dir: &Path, report: &mut Report, rec: &Recording, track: &Track) -> Result<()> {
+    sensors_csv(dir, rec, track)?;
     let sec = report.section("sensors", "Sensor errors estimated in flight");
     sec.paragraph(
         "The inertial-satellite filter's gyro drift and accelerometer bias estimates \
@@ -225,58 +284,10 @@ fn sensors(dir: &Path, report: &mut Report, rec: &Recording, track: &Track) -> R
          3-sigma bounds around the estimate. Vertical gyro drift and level accelerometer \
          biases are observable only when the helicopter turns and accelerates.",
     );
-    let t: Vec<f64> = track.sensors.iter().map(|x| x.t).collect();
-    for (name, unit, label, get) in [
-        ("gyro", DEG_PER_H, "deg/h", 0usize),
-        ("accel", UG, "ug", 1usize),
-    ] {
+    for k in Triad::ALL {
         for (i, axis) in ["x", "y", "z"].iter().enumerate() {
-            let pick = |f: &dyn Fn(&super::modes::SensorEpoch) -> f64| -> Vec<f64> {
-                track.sensors.iter().map(|x| f(x) / unit).collect()
-            };
-            let est = pick(&|x| {
-                if get == 0 {
-                    x.est.gyro_bias[i]
-                } else {
-                    x.est.accel_bias[i]
-                }
-            });
-            let sd = pick(&|x| {
-                if get == 0 {
-                    x.gyro_std[i]
-                } else {
-                    x.accel_std[i]
-                }
-            });
-            let truth: Vec<f64> = track
-                .sensors
-                .iter()
-                .map(|x| {
-                    let tr = rec.truth_at(x.t);
-                    (if get == 0 {
-                        tr.gyro_bias[i]
-                    } else {
-                        tr.accel_bias[i]
-                    }) / unit
-                })
-                .collect();
-            let hi: Vec<f64> = est.iter().zip(&sd).map(|(e, s)| e + 3.0 * s).collect();
-            let lo: Vec<f64> = est.iter().zip(&sd).map(|(e, s)| e - 3.0 * s).collect();
-            let what = if get == 0 {
-                "Gyro drift"
-            } else {
-                "Accelerometer bias"
-            };
-            let p = Plot::new(
-                &format!("{what}, {axis} axis"),
-                "t [s]",
-                &format!("{name}_{axis} [{label}]"),
-            )
-            .line("estimate", &t, &est, LineStyle::Solid)
-            .line("truth", &t, &truth, LineStyle::Dashed)
-            .line("estimate + 3 sigma", &t, &hi, LineStyle::Dotted)
-            .line("estimate - 3 sigma", &t, &lo, LineStyle::Dotted);
-            let file = format!("{name}_{axis}.svg");
+            let p = sensor_plot(rec, track, k, i, axis);
+            let file = format!("{}_{axis}.svg", k.names().0);
             svg(dir, &file, &p)?;
             sec.plot_with_files(&p, &[&file, "sensors.csv"]);
         }
@@ -362,25 +373,9 @@ fn alignment_section(
     Ok(())
 }
 
-/// Write every output and return the text summary for stdout.
-#[allow(clippy::too_many_arguments)]
-pub fn write(
-    dir: &Path,
-    s: &Sortie,
-    rec: &Recording,
-    a: &Alignments,
-    runs: &[ModeRun],
-    polar: &Polar,
-    gains: Gains,
-    timing: Timing,
-    started: Instant,
-) -> Result<String> {
-    for r in runs {
-        write_mode(dir, r)?;
-    }
-    let end = rec.truth.last().map_or(0.0, |e| e.state.t);
-    let mut report = Report::new("schuler demo: a polar helicopter sortie, re-enacted");
-    report.paragraph(&format!(
+/// The report's opening paragraph: the flight test, the sortie's timing and the data.
+fn introduction(s: &Sortie, rec: &Recording, end: f64) -> String {
+    format!(
         "The second seed document's flight test of a strapdown inertial-satellite system on \
          fibre-optic gyros, re-enacted on simulated data: a helicopter at {:.1} N, {:.0} s on the \
          pad with the rotor turning, then {:.0} s of flight; IMU at {:.0} Hz (navigation \
@@ -397,9 +392,12 @@ pub fn write(
         } else {
             ""
         }
-    ));
+    )
+}
 
-    // Trajectory map.
+/// The truth's east and north of the pad [km], on the plane tangent at the pad (the
+/// pad's meridian and prime-vertical radii).
+fn track_from_pad(rec: &Recording) -> (Vec<f64>, Vec<f64>) {
     let t0 = &rec.truth[0].state;
     let r0 = schuler::earth::EarthModel::radii(&schuler::earth::Wgs84, t0.pos.lat);
     let east: Vec<f64> = rec
@@ -412,6 +410,37 @@ pub fn write(
         .iter()
         .map(|e| (e.state.pos.lat - t0.pos.lat) * r0.meridian / 1e3)
         .collect();
+    (east, north)
+}
+
+/// The sortie's phases, each from and to [s].
+fn timeline(s: &Sortie, end: f64) -> Table {
+    [
+        ("coarse alignment", s.t0(), s.coarse_end()),
+        ("fine alignment", s.coarse_end(), s.nav_start()),
+        ("navigation on the pad", s.nav_start(), s.takeoff),
+        ("flight", s.takeoff, end),
+    ]
+    .into_iter()
+    .fold(
+        Table::new(["phase", "from [s]", "to [s]"]),
+        |table, (phase, from, to)| {
+            table.row([phase.to_string(), format!("{from:.0}"), format!("{to:.0}")])
+        },
+    )
+    .caption("Timeline")
+}
+
+/// The sortie's section: its timeline, the GNSS outages and the ground track
+/// (`trajectory.csv`, `trajectory.svg`).
+fn sortie_section(
+    dir: &Path,
+    report: &mut Report,
+    s: &Sortie,
+    rec: &Recording,
+    end: f64,
+) -> Result<()> {
+    let (east, north) = track_from_pad(rec);
     csv(
         dir,
         "trajectory.csv",
@@ -429,38 +458,25 @@ pub fn write(
     );
     svg(dir, "trajectory.svg", &map)?;
     let sec = report.section("sortie", "The sortie");
-    sec.table(
-        Table::new(["phase", "from [s]", "to [s]"])
-            .row([
-                "coarse alignment".to_string(),
-                format!("{:.0}", s.t0()),
-                format!("{:.0}", s.coarse_end()),
-            ])
-            .row([
-                "fine alignment".to_string(),
-                format!("{:.0}", s.coarse_end()),
-                format!("{:.0}", s.nav_start()),
-            ])
-            .row([
-                "navigation on the pad".to_string(),
-                format!("{:.0}", s.nav_start()),
-                format!("{:.0}", s.takeoff),
-            ])
-            .row([
-                "flight".to_string(),
-                format!("{:.0}", s.takeoff),
-                format!("{end:.0}"),
-            ])
-            .caption("Timeline"),
-    );
+    sec.table(timeline(s, end));
     for (a0, b0) in &s.outages {
         sec.paragraph(&format!("GNSS outage from {a0:.0} s to {b0:.0} s."));
     }
     sec.plot_with_files(&map, &["trajectory.svg", "trajectory.csv"]);
+    Ok(())
+}
 
-    alignment_section(dir, &mut report, rec, a, s)?;
-
-    // Inertial mode.
+/// The inertial mode's section: the circular error after the fine alignment and after
+/// the coarse one alone (`inertial_circular.svg`).
+fn inertial_section(
+    dir: &Path,
+    report: &mut Report,
+    s: &Sortie,
+    rec: &Recording,
+    a: &Alignments,
+    runs: &[ModeRun],
+    end: f64,
+) -> Result<()> {
     let inertial = find(runs, "inertial")?;
     let coarse = find(runs, "inertial_coarse")?;
     let p = plot_circular(
@@ -498,8 +514,25 @@ pub fn write(
                 "errors_inertial_coarse.csv",
             ],
         );
+    Ok(())
+}
 
-    // Inertial-satellite mode.
+/// How many GNSS fixes the filter's gate refused (a fix refused twice counts once).
+fn refused_fixes(track: &Track) -> usize {
+    let mut t = track.rejected.clone();
+    t.dedup();
+    t.len()
+}
+
+/// The inertial-satellite mode's section: the filter's and the smoother's circular
+/// error (`aided_circular.svg`) and the gate's refusals.
+fn aided_section(
+    dir: &Path,
+    report: &mut Report,
+    s: &Sortie,
+    rec: &Recording,
+    runs: &[ModeRun],
+) -> Result<()> {
     let forward = find(runs, "aided")?;
     let smoothed = find(runs, "smoothed")?;
     let p = plot_circular(
@@ -514,11 +547,7 @@ pub fn write(
          velocity differences with the antenna's lever arm, the barometer's height, and a \
          chi-square gate; then the Rauch-Tung-Striebel smoother. The gate refused {} fix(es) \
          (the simulator injected outliers at {}).",
-        {
-            let mut t = forward.track.rejected.clone();
-            t.dedup();
-            t.len()
-        },
+        refused_fixes(&forward.track),
         rec.gnss_outliers
             .iter()
             .map(|t| format!("{t:.0} s"))
@@ -533,11 +562,15 @@ pub fn write(
             "errors_smoothed.csv",
         ],
     );
+    Ok(())
+}
 
-    sensors(dir, &mut report, rec, &forward.track)?;
-
-    // Vertical channel.
+/// The vertical channel's section: the height error free, with the baro loop (34) and
+/// in the filter (`vertical.svg`), and the loop's fault detector.
+fn vertical_section(dir: &Path, report: &mut Report, runs: &[ModeRun], gains: Gains) -> Result<()> {
     let no_baro = find(runs, "inertial_no_baro")?;
+    let inertial = find(runs, "inertial")?;
+    let forward = find(runs, "aided")?;
     let mut p = Plot::new("Vertical channel: height error", "t [s]", "dh [m]");
     for r in [no_baro, inertial, forward] {
         let y: Vec<f64> = r.errors.iter().map(height).collect();
@@ -562,12 +595,20 @@ pub fn write(
                 "errors_inertial.csv",
             ],
         );
+    Ok(())
+}
 
-    let polar_rows = page_polar::section(dir, &mut report, polar)?;
-
-    // Summary.
-    let rows: Vec<Vec<String>> = runs.iter().map(|r| summary_row(r, s, end)).collect();
-    let table = table_with_csv(dir, "summary.csv", &SUMMARY_HEADER, &rows)?;
+/// The summary section: the table of `rows` (also `summary.csv`) and the run times;
+/// returns the run time so far [s].
+fn summary_section(
+    dir: &Path,
+    report: &mut Report,
+    rows: &[Vec<String>],
+    polar: &Polar,
+    timing: Timing,
+    started: Instant,
+) -> Result<f64> {
+    let table = table_with_csv(dir, "summary.csv", &SUMMARY_HEADER, rows)?;
     let total = started.elapsed().as_secs_f64();
     let sec = report.section("summary", "Summary");
     sec.table(table.caption("Errors at the end of each phase (summary.csv)"));
@@ -577,19 +618,21 @@ pub fn write(
          this report. The crossing's errors are in its own table (section Across the pole).",
         timing.simulate, timing.align, polar.simulate_s, total
     ));
-    let missing = report.plots_missing_units();
-    anyhow::ensure!(missing.is_empty(), "plots without units: {missing:?}");
-    let path = dir.join("report.html");
-    report.write(&path)?;
+    Ok(total)
+}
 
+/// The text for stdout: the `headline`, one line per mode of the sortie (`rows`) and of
+/// the crossing (`polar_rows`), and where the report is.
+fn stdout_text(
+    headline: &str,
+    rows: &[Vec<String>],
+    polar: &Polar,
+    polar_rows: &[Vec<String>],
+    report: &Path,
+) -> String {
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "schuler demo: polar helicopter sortie ({:.0} s at {:.0} Hz) in {total:.1} s",
-        end - s.t0(),
-        rec.rate
-    );
-    for r in &rows {
+    let _ = writeln!(out, "{headline}");
+    for r in rows {
         let _ = writeln!(
             out,
             "  {:<36} dS at end {:>10} m, max in flight {:>10} m",
@@ -601,13 +644,53 @@ pub fn write(
         "across the pole ({:.0} s at {:.0} Hz):",
         polar.crossing.duration, polar.rec.rate
     );
-    for r in &polar_rows {
+    for r in polar_rows {
         let _ = writeln!(
             out,
             "  {:<36} dS at end {:>10} m, max {:>10} m",
             r[0], r[4], r[5]
         );
     }
-    let _ = write!(out, "report: {}", path.display());
-    Ok(out)
+    let _ = write!(out, "report: {}", report.display());
+    out
+}
+
+/// Write every output and return the text summary for stdout.
+#[allow(clippy::too_many_arguments)]
+pub fn write(
+    dir: &Path,
+    s: &Sortie,
+    rec: &Recording,
+    a: &Alignments,
+    runs: &[ModeRun],
+    polar: &Polar,
+    gains: Gains,
+    timing: Timing,
+    started: Instant,
+) -> Result<String> {
+    for r in runs {
+        write_mode(dir, r)?;
+    }
+    let end = rec.truth.last().map_or(0.0, |e| e.state.t);
+    let mut report = Report::new("schuler demo: a polar helicopter sortie, re-enacted");
+    report.paragraph(&introduction(s, rec, end));
+    sortie_section(dir, &mut report, s, rec, end)?;
+    alignment_section(dir, &mut report, rec, a, s)?;
+    inertial_section(dir, &mut report, s, rec, a, runs, end)?;
+    aided_section(dir, &mut report, s, rec, runs)?;
+    sensors(dir, &mut report, rec, &find(runs, "aided")?.track)?;
+    vertical_section(dir, &mut report, runs, gains)?;
+    let polar_rows = page_polar::section(dir, &mut report, polar)?;
+    let rows: Vec<Vec<String>> = runs.iter().map(|r| summary_row(r, s, end)).collect();
+    let total = summary_section(dir, &mut report, &rows, polar, timing, started)?;
+    let missing = report.plots_missing_units();
+    anyhow::ensure!(missing.is_empty(), "plots without units: {missing:?}");
+    let path = dir.join("report.html");
+    report.write(&path)?;
+    let headline = format!(
+        "schuler demo: polar helicopter sortie ({:.0} s at {:.0} Hz) in {total:.1} s",
+        end - s.t0(),
+        rec.rate
+    );
+    Ok(stdout_text(&headline, &rows, polar, &polar_rows, &path))
 }

@@ -193,22 +193,16 @@ fn azimuth(dir: &Path, p: &Polar, inertial: &ModeRun, aided: &ModeRun) -> Result
     Ok(plot)
 }
 
-/// Write the crossing's files and its section into `report`; returns the summary
-/// rows.
-pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<String>>> {
-    for r in &p.runs {
-        write_mode(dir, r)?;
-    }
-    let c = &p.crossing;
-    let inertial = find(&p.runs, "polar_inertial")?;
-    let forward = find(&p.runs, "polar_aided")?;
-    let smoothed = find(&p.runs, "polar_smoothed")?;
-    let ned = find(&p.runs, "polar_ned")?;
-    let lat0 = p.rec.truth[0].state.pos.lat.to_degrees();
-    let across = std::f64::consts::TAU * c.weave.0 / c.weave.1;
+/// Peak cross-track speed of the crossing's weave [m/s]: 2π × amplitude / period.
+fn weave_speed(c: &Crossing) -> f64 {
+    std::f64::consts::TAU * c.weave.0 / c.weave.1
+}
 
-    let sec = report.section("polar", "Across the pole");
-    sec.paragraph(&format!(
+/// The section's opening paragraph: the flight, its simulation and the hand-over.
+fn introduction(p: &Polar) -> String {
+    let c = &p.crossing;
+    let lat0 = p.rec.truth[0].state.pos.lat.to_degrees();
+    format!(
         "A second, short flight: the sortie's helicopter with the same IMU, GNSS and \
          barometer (examples/polar_flight.toml, at {:.0} Hz) flies {:.0} s at {:.0} m/s and \
          300 m from {lat0:.2} N on 25 E straight over the North Pole (at t = {:.0} s) to \
@@ -226,45 +220,34 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
         c.t_pole(),
         c.weave.0,
         c.weave.1,
-        across.atan2(c.speed).to_degrees(),
+        weave_speed(c).atan2(c.speed).to_degrees(),
         c.handover.pos_n.norm(),
         c.handover.v_n.norm(),
         c.handover.psi.xy().norm().to_degrees() * 60.0,
         c.handover.psi.z.abs().to_degrees() * 60.0,
         c.outage.0,
         c.outage.1,
-    ));
-    sec.paragraph(
-        "The all-latitude wander-azimuth mechanization (the seed's: position as the \
-         wander-to-Earth quaternion, the navigation frame's vertical rate relative to the \
-         Earth held at zero, so nothing depends on the direction of north) navigates it in \
-         the inertial mode with the baro loop and in the inertial-satellite mode, the \
-         filter's errors resolved in the wander frame. Errors, as everywhere in schuler, are \
-         differences in ECEF resolved along the truth's north and east: latitude and \
-         longitude differences (R dlat, R cos(lat) dlon) would fail here, because within \
-         tens of metres of the pole a metre of error spans degrees of longitude (two \
-         points 30 m from the pole on \
-         opposite meridians are 60 m apart, not 94 m), and each state's velocity and heading \
-         are in its own north.",
-    );
-    let map = ground_track(dir, p, &[inertial, ned])?;
-    sec.plot_with_files(&map, &["polar_track.svg", "polar_track.csv"]);
+    )
+}
 
-    let p_free = plot_circular(
-        "Across the pole, inertial mode: circular error dS",
-        &[inertial, ned],
-        &[c.outage],
-    );
-    svg(dir, "polar_inertial_circular.svg", &p_free)?;
-    let p_aided = plot_circular(
-        "Across the pole, inertial-satellite mode: circular error dS",
-        &[forward, smoothed],
-        &[c.outage],
-    );
-    svg(dir, "polar_aided_circular.svg", &p_aided)?;
+/// How the wander-azimuth mechanization navigates the crossing and how its errors are
+/// measured.
+const WANDER_MECHANIZATION: &str = "The all-latitude wander-azimuth mechanization (the \
+     seed's: position as the wander-to-Earth quaternion, the navigation frame's vertical \
+     rate relative to the Earth held at zero, so nothing depends on the direction of \
+     north) navigates it in the inertial mode with the baro loop and in the \
+     inertial-satellite mode, the filter's errors resolved in the wander frame. Errors, as \
+     everywhere in schuler, are differences in ECEF resolved along the truth's north and \
+     east: latitude and longitude differences (R dlat, R cos(lat) dlon) would fail here, \
+     because within tens of metres of the pole a metre of error spans degrees of \
+     longitude (two points 30 m from the pole on opposite meridians are 60 m apart, not \
+     94 m), and each state's velocity and heading are in its own north.";
 
-    // The NED mechanization on the same samples, against the wander one.
-    let apart = inertial
+/// The NED mechanization on the crossing's samples against the wander one: how close
+/// its track passes the pole, how far its latitude goes, how fast its longitude turns,
+/// and how far apart the two positions come.
+fn ned_contrast(p: &Polar, wander: &ModeRun, ned: &ModeRun) -> String {
+    let apart = wander
         .track
         .epochs
         .iter()
@@ -278,8 +261,8 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
         .map(|e| e.state.pos.lat)
         .fold(f64::NEG_INFINITY, f64::max);
     let closest = closest_approach(&ned.track);
-    let ground_speed = c.speed.hypot(across);
-    sec.paragraph(&format!(
+    let ground_speed = p.crossing.speed.hypot(weave_speed(&p.crossing));
+    format!(
         "The NED mechanization on the same samples (inertial mode): its own track passes {:.1} m \
          from the pole (between its 1-s epochs; its navigation error keeps it off the exact \
          point), its latitude {} 90 deg (largest {:.6} deg), and its longitude swings through \
@@ -301,7 +284,60 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
         ground_speed / closest,
         ground_speed / p.rec.rate / closest * 1e3,
         m(apart),
-    ));
+    )
+}
+
+/// The wander azimuth's half turn at the pole, read from the inertial run `wander` 10 s
+/// before and after it (alpha' = lon' sin(lat)).
+fn azimuth_text(c: &Crossing, wander: &ModeRun) -> String {
+    let alpha_at = |t: f64| {
+        state_index(&wander.track, t)
+            .and_then(|k| wander.track.epochs[k].wander_azimuth)
+            .map_or(f64::NAN, f64::to_degrees)
+    };
+    format!(
+        "The wander azimuth (the wander frame's x axis east of north) starts at 0 and turns \
+         only as the meridians converge under the helicopter, alpha' = lon' sin(lat): slowly \
+         while it weaves, then by half a turn as it crosses the pole ({:.1} deg 10 s before, \
+         {:.1} deg 10 s after), exactly as north itself flips (the true heading). The \
+         heading in the wander frame, yaw - alpha, is smooth throughout: nothing in the \
+         mechanization sees the pole.",
+        alpha_at(c.t_pole() - 10.0),
+        alpha_at(c.t_pole() + 10.0),
+    )
+}
+
+/// Write the crossing's files and its section into `report`; returns the summary
+/// rows.
+pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<String>>> {
+    for r in &p.runs {
+        write_mode(dir, r)?;
+    }
+    let c = &p.crossing;
+    let inertial = find(&p.runs, "polar_inertial")?;
+    let forward = find(&p.runs, "polar_aided")?;
+    let smoothed = find(&p.runs, "polar_smoothed")?;
+    let ned = find(&p.runs, "polar_ned")?;
+
+    let sec = report.section("polar", "Across the pole");
+    sec.paragraph(&introduction(p));
+    sec.paragraph(WANDER_MECHANIZATION);
+    let map = ground_track(dir, p, &[inertial, ned])?;
+    sec.plot_with_files(&map, &["polar_track.svg", "polar_track.csv"]);
+
+    let p_free = plot_circular(
+        "Across the pole, inertial mode: circular error dS",
+        &[inertial, ned],
+        &[c.outage],
+    );
+    svg(dir, "polar_inertial_circular.svg", &p_free)?;
+    let p_aided = plot_circular(
+        "Across the pole, inertial-satellite mode: circular error dS",
+        &[forward, smoothed],
+        &[c.outage],
+    );
+    svg(dir, "polar_aided_circular.svg", &p_aided)?;
+    sec.paragraph(&ned_contrast(p, inertial, ned));
     sec.plot_with_files(
         &p_free,
         &[
@@ -320,21 +356,7 @@ pub fn section(dir: &Path, report: &mut Report, p: &Polar) -> Result<Vec<Vec<Str
     );
 
     let az = azimuth(dir, p, inertial, forward)?;
-    let alpha_at = |t: f64| {
-        state_index(&inertial.track, t)
-            .and_then(|k| inertial.track.epochs[k].wander_azimuth)
-            .map_or(f64::NAN, f64::to_degrees)
-    };
-    sec.paragraph(&format!(
-        "The wander azimuth (the wander frame's x axis east of north) starts at 0 and turns \
-         only as the meridians converge under the helicopter, alpha' = lon' sin(lat): slowly \
-         while it weaves, then by half a turn as it crosses the pole ({:.1} deg 10 s before, \
-         {:.1} deg 10 s after), exactly as north itself flips (the true heading). The \
-         heading in the wander frame, yaw - alpha, is smooth throughout: nothing in the \
-         mechanization sees the pole.",
-        alpha_at(c.t_pole() - 10.0),
-        alpha_at(c.t_pole() + 10.0),
-    ));
+    sec.paragraph(&azimuth_text(c, inertial));
     sec.plot_with_files(&az, &["polar_azimuth.svg", "polar_azimuth.csv"]);
 
     let rows: Vec<Vec<String>> = p.runs.iter().map(|r| summary_row(r, c)).collect();
