@@ -214,7 +214,7 @@ fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {
 
 /// The flag of `nav` that sets a session configuration field.
 fn flag_of(field: &str) -> &'static str {
-    const FLAGS: [(&str, &str); 27] = [
+    const FLAGS: [(&str, &str); 28] = [
         ("mechanization.auto_latitude", "--auto-latitude"),
         ("mechanization.hysteresis", "--auto-hysteresis"),
         ("output_rate", "--output-rate"),
@@ -254,6 +254,7 @@ fn flag_of(field: &str) -> &'static str {
         ("filter.vehicle.nhc.std", "--nhc-std"),
         ("filter.vehicle.odometer_std", "--odometer-std"),
         ("filter.vehicle.odometer_scale_std", "--odometer-scale-std"),
+        ("filter.vehicle.mounting_std", "--estimate-mounting"),
     ];
     FLAGS
         .iter()

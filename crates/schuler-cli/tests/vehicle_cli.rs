@@ -292,3 +292,81 @@ fn bad_vehicle_inputs_name_file_line_and_field() {
             );
     }
 }
+
+/// `--estimate-mounting`: the drive's IMU turned in the car by 2° of pitch and 3° of
+/// yaw (its increments rotated, `x_b = C_bv x_v`), the filter told nothing: with the
+/// NHC and the odometer the printed mounting comes back within the 0.2°.
+#[test]
+fn the_mounting_is_estimated_from_the_constraints() {
+    let d = drive();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let q_bv = Euler::from_degrees(0.0, 2.0, 3.0).to_quaternion();
+    let turned: String = common::read_rows(&d.join("imu.txt"))
+        .iter()
+        .map(|r| {
+            let w = q_bv * nalgebra::Vector3::new(r[1], r[2], r[3]);
+            let f = q_bv * nalgebra::Vector3::new(r[4], r[5], r[6]);
+            format!(
+                "{} {:e} {:e} {:e} {:e} {:e} {:e}\n",
+                r[0], w.x, w.y, w.z, f.x, f.y, f.z
+            )
+        })
+        .collect();
+    let imu = dir.path().join("imu_turned.txt");
+    std::fs::write(&imu, turned).expect("write");
+    // The IMU's own attitude at the start: the car's turned by the mounting.
+    let start = Euler::from_quaternion(
+        &(Euler::from_degrees(0.0, 0.0, 10.0).to_quaternion() * q_bv.inverse()),
+    );
+    let o = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--imu"])
+        .arg(&imu)
+        .arg("--gnss")
+        .arg(d.join("gnss.txt"))
+        .args(["--init-pos", "45.07,7.68,245", "--init-att"])
+        .arg(format!(
+            "{},{},{}",
+            start.roll.to_degrees(),
+            start.pitch.to_degrees(),
+            start.yaw.to_degrees()
+        ))
+        .args([
+            "--lever-arm",
+            "0.5,0,-1",
+            "--imu-grade",
+            "tactical",
+            "--nhc",
+        ])
+        .arg("--odometer")
+        .arg(d.join("odometer.txt"))
+        .args([
+            "--estimate-mounting",
+            "--no-report",
+            "--output-rate",
+            "1",
+            "--out",
+        ])
+        .arg(dir.path().join("out"))
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("mounting estimated"))
+        .unwrap_or_else(|| panic!("no mounting line: {stdout}"));
+    let number = |after: &str| -> f64 {
+        let rest = &line[line.find(after).expect("field") + after.len()..];
+        rest.split_whitespace()
+            .next()
+            .expect("value")
+            .parse()
+            .expect("number")
+    };
+    let (pitch, yaw) = (number("pitch "), number("yaw "));
+    eprintln!("{line}");
+    assert!(
+        (pitch - 2.0).abs() < 0.2 && (yaw - 3.0).abs() < 0.2,
+        "{line}"
+    );
+}

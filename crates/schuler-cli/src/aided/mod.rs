@@ -249,6 +249,11 @@ pub struct AidingOptions {
     /// [deg] (0,0,0 when the IMU's axes are the vehicle's front, right, down).
     #[arg(long, allow_hyphen_values = true, value_name = "R,P,Y")]
     pub mounting_angles: Option<Triple>,
+    /// Estimate the vehicle frame's pitch and yaw relative to --mounting-angles as
+    /// filter states (needs --nhc or --odometer), prior standard deviation (e.g.
+    /// `5 deg`; the flag alone: 5 deg).
+    #[arg(long, value_name = "ANGLE", num_args = 0..=1, default_missing_value = "5 deg")]
+    pub estimate_mounting: Option<String>,
     /// The point the NHC and the odometer speak of (the rear axle's centre, the
     /// odometer wheel) in IMU body axes, front, right, down [m] (default 0,0,0).
     #[arg(long, allow_hyphen_values = true, value_name = "X,Y,Z")]
@@ -308,6 +313,7 @@ impl AidingOptions {
             odometer_std,
             odometer_scale_std,
             mounting_angles,
+            estimate_mounting,
             vehicle_lever_arm,
             dual_antenna,
             dual_antenna_baseline_yaw,

@@ -84,6 +84,12 @@ pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
             "--odometer",
         ),
         (
+            o.estimate_mounting.is_some(),
+            "estimate-mounting",
+            o.nhc || o.odometer.is_some(),
+            "--nhc or --odometer",
+        ),
+        (
             o.dual_antenna_baseline_yaw.is_some(),
             "dual-antenna-baseline-yaw",
             o.dual_antenna.is_some(),
@@ -257,6 +263,15 @@ pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, Ve
     };
     let (odometer_std, odometer_scale_std) = odometer(o, &mut readings.odometer)?;
     let heading_baseline = heading_baseline(o, &mut readings.headings)?;
+    let mounting_std = match &o.estimate_mounting {
+        None => None,
+        Some(_) => Some(positive(
+            "estimate-mounting",
+            &o.estimate_mounting,
+            Dimension::Angle,
+            0.0,
+        )?),
+    };
     let config = VehicleConfig {
         mount: mount(o)?,
         rest,
@@ -264,6 +279,7 @@ pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, Ve
         odometer_std,
         odometer_scale_std,
         heading_baseline,
+        mounting_std,
     };
     Ok((config, readings))
 }

@@ -523,6 +523,17 @@ fn print_aided(
     if let Some(line) = crate::aided::vehicle::summary(&c) {
         println!("{line}");
     }
+    if let Some((mount, [sp, sy])) = summary.nav.mounting {
+        let e = schuler::rotation::Euler::from_quaternion(&mount.q_vb);
+        println!(
+            "mounting estimated: the vehicle frame's roll {:.3}, pitch {:.3} ± {:.3}, yaw {:.3} ± {:.3} deg relative to the IMU (use as --mounting-angles)",
+            e.roll.to_degrees(),
+            e.pitch.to_degrees(),
+            sp.to_degrees(),
+            e.yaw.to_degrees(),
+            sy.to_degrees()
+        );
+    }
     if let Some(test) = &aiding.outage_test {
         crate::aided::report_outage_test(
             &settings.out.join("nav.txt"),

@@ -136,6 +136,9 @@ pub struct VehicleConfig {
     pub odometer_scale_std: Option<f64>,
     /// The dual-antenna baseline; `None`: heading aids ignored.
     pub heading_baseline: Option<Baseline>,
+    /// Estimate the vehicle frame's pitch and yaw relative to `mount` with this prior
+    /// standard deviation [rad] (two filter states; needs the NHC or the odometer).
+    pub mounting_std: Option<f64>,
 }
 
 impl VehicleConfig {
@@ -158,6 +161,7 @@ impl Default for VehicleConfig {
             odometer_std: None,
             odometer_scale_std: None,
             heading_baseline: None,
+            mounting_std: None,
         }
     }
 }
@@ -455,6 +459,15 @@ impl FilterConfig {
         }
         if let Some(s) = v.odometer_scale_std {
             positive("filter.vehicle.odometer_scale_std", s)?;
+        }
+        if let Some(s) = v.mounting_std {
+            positive("filter.vehicle.mounting_std", s)?;
+            if v.nhc.is_none() && v.odometer_std.is_none() {
+                return Err(ConfigError::new(
+                    "filter.vehicle.mounting_std",
+                    "the mounting is observed through the NHC or the odometer: configure one",
+                ));
+            }
         }
         if let Some(b) = &v.heading_baseline
             && !(b.yaw.is_finite() && b.pitch.is_finite() && b.pitch.abs() < 89f64.to_radians())

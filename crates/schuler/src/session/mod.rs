@@ -122,6 +122,12 @@ pub struct Summary {
     pub mean_nis_per_dof: f64,
     /// The filter's state layout, when it ran.
     pub layout: Option<Layout>,
+    /// The filter's sensor-error estimates at the end, when it ran.
+    pub estimates: Option<crate::filter::SensorEstimates>,
+    /// The vehicle mount at the end (the configured one with the estimated mounting
+    /// errors removed) and the standard deviations of its pitch and yaw [rad], when
+    /// the mounting was estimated.
+    pub mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
     /// What the baro loop's fault detector did, when it ran.
     pub baro_loop: Option<DetectorCounts>,
 }
@@ -382,17 +388,16 @@ impl<E: EarthModel> Session<E> {
         };
         let run = self.run;
         let (last, ..) = core.read_out();
-        let (counts, layout, smoothed) = match &core {
+        let end = match &core {
             Core::FilterNed(i) => filter_end(i, &run.cfg),
             Core::FilterWander(i) => filter_end(i, &run.cfg),
-            _ => (
-                Counts {
+            _ => FilterEnd {
+                counts: Counts {
                     skipped: run.skipped_free,
                     ..Counts::default()
                 },
-                None,
-                None,
-            ),
+                ..FilterEnd::default()
+            },
         };
         let (sum, dof) = run.nis;
         Ok(Finished {
@@ -403,19 +408,21 @@ impl<E: EarthModel> Session<E> {
                 last,
                 first_mechanization: run.first_mechanization,
                 handovers: run.handovers,
-                counts,
+                counts: end.counts,
                 late: run.late,
                 ignored: run.ignored,
                 envelope_warnings: run.left_envelope.iter().filter(|x| **x).count() as u64,
                 gate_resets: run.gate_resets,
                 mean_nis_per_dof: if dof > 0 { sum / dof as f64 } else { f64::NAN },
-                layout,
+                layout: end.layout,
+                estimates: end.estimates,
+                mounting: end.mounting,
                 baro_loop: run.baro_loop.map(|l| l.counts),
             },
             epochs: run.epochs.into(),
             events: run.events.into(),
             snapshots: run.snapshots.map_or_else(Vec::new, |s| s.taken),
-            smoothed,
+            smoothed: end.smoothed,
         })
     }
 
@@ -469,13 +476,39 @@ fn epoch_of<E: EarthModel>(core: &Core<E>) -> Epoch {
     }
 }
 
-/// The filter's counts and layout, and the smoothed trajectory when asked.
+/// What the filter leaves at the end of a session.
+#[derive(Default)]
+struct FilterEnd {
+    counts: Counts,
+    layout: Option<Layout>,
+    estimates: Option<crate::filter::SensorEstimates>,
+    mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
+    smoothed: Option<Vec<Smoothed>>,
+}
+
+/// The filter's counts, layout, estimates and mount, and the smoothed trajectory when
+/// asked.
 fn filter_end<M: ErrorFrame, E: EarthModel>(
     i: &Integrator<M, E>,
     cfg: &SessionConfig,
-) -> (Counts, Option<Layout>, Option<Vec<Smoothed>>) {
-    let smooth = cfg.filter.is_some_and(|f| f.smooth);
-    (i.counts, Some(i.layout()), smooth.then(|| i.smoothed()))
+) -> FilterEnd {
+    let filter = cfg.filter.as_ref();
+    let smooth = filter.is_some_and(|f| f.smooth);
+    let p = i.covariance();
+    let mounting = match (i.layout().mounting, filter) {
+        (Some(o), Some(f)) => Some((
+            f.vehicle.mount.corrected(&i.estimates().mounting),
+            [p[(o, o)].max(0.0).sqrt(), p[(o + 1, o + 1)].max(0.0).sqrt()],
+        )),
+        _ => None,
+    };
+    FilterEnd {
+        counts: i.counts,
+        layout: Some(i.layout()),
+        estimates: Some(i.estimates()),
+        mounting,
+        smoothed: smooth.then(|| i.smoothed()),
+    }
 }
 
 impl Loop {

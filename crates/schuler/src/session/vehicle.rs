@@ -53,13 +53,18 @@ impl VehicleRun {
         }
     }
 
-    /// The integrator with the states these aids need (the odometer scale factor).
+    /// The integrator with the states these aids need (the odometer scale factor, the
+    /// mounting).
     pub fn configure<M: ErrorFrame, E: EarthModel>(
         &self,
         integ: Integrator<M, E>,
     ) -> Integrator<M, E> {
-        match self.cfg.odometer_scale_std {
+        let integ = match self.cfg.odometer_scale_std {
             Some(std) => integ.with_odometer_scale(std, 0.0),
+            None => integ,
+        };
+        match self.cfg.mounting_std {
+            Some(std) => integ.with_mounting(std),
             None => integ,
         }
     }
