@@ -312,13 +312,41 @@ pub fn start_in_motion<E: EarthModel>(
     cfg: &InMotionConfig,
 ) -> Result<InMotionStart, InMotionError> {
     let (i, j) = best_pair(earth, samples, fixes, course_pair(earth, fixes, cfg)?, cfg);
+    let mut start = start_at_fix(earth, samples, fixes, i, j, cfg)?;
     let (a, b) = (&fixes[i], &fixes[j]);
-    let t_m = 0.5 * (a.t + b.t);
-    let sample = sample_near(samples, b.t).ok_or(InMotionError::NoSamples { t: b.t })?;
-    let t_s = samples[sample].t;
     // The course of the chord is the heading at its middle; the gyros carry it on.
     let (course, sigma_course) = line_course(earth, fixes, i, j);
-    let yaw = crate::rotation::wrap_pi(course + turned(samples, t_m, t_s));
+    let t_m = 0.5 * (a.t + b.t);
+    let yaw = crate::rotation::wrap_pi(course + turned(samples, t_m, start.state.t));
+    let e = start.state.euler();
+    start.state = NavState::new(
+        start.state.t,
+        start.state.pos,
+        start.state.v_n,
+        Euler { yaw, ..e },
+    );
+    start.att_std.z = sigma_course
+        .hypot(turned(samples, a.t, b.t).abs() / 6.0)
+        .hypot(cfg.sideslip);
+    Ok(start)
+}
+
+/// A start at fix `j` without a heading (yaw 0 with a standard deviation of π):
+/// position that fix's, velocity differenced over the last [`VELOCITY_SPAN`] of fixes
+/// (not before fix `i`), tilts from the accelerometers with the acceleration's
+/// uncertainty (module doc). The heading comes from elsewhere: the course
+/// ([`start_in_motion`]) or a bank of filters (`session::HeadingBank`).
+pub fn start_at_fix<E: EarthModel>(
+    earth: &E,
+    samples: &[ImuSample],
+    fixes: &[GnssFix],
+    i: usize,
+    j: usize,
+    cfg: &InMotionConfig,
+) -> Result<InMotionStart, InMotionError> {
+    let b = &fixes[j];
+    let sample = sample_near(samples, b.t).ok_or(InMotionError::NoSamples { t: b.t })?;
+    let t_s = samples[sample].t;
     let (v_n, sigma_v) = velocity_at(earth, fixes, i, j, VELOCITY_SPAN);
     let (v_before, _) = velocity_at(
         earth,
@@ -346,28 +374,33 @@ pub fn start_in_motion<E: EarthModel>(
         return Err(InMotionError::NoSamples { t: t_s });
     }
     let f_b = sum_dv / sum_dt;
-    let g = local.g_n.z;
     let naive_pitch = f_b.x.atan2(f_b.y.hypot(f_b.z));
     let (pitch, roll) = tilt(&f_b.normalize(), &Vector3::new(0.0, 0.0, -1.0), naive_pitch);
-    let course_std = sigma_course
-        .hypot(turned(samples, a.t, b.t).abs() / 6.0)
-        .hypot(cfg.sideslip);
-    let tilt_std = (accel / g).hypot(0.2f64.to_radians());
+    let tilt_std = (accel / local.g_n.z).hypot(0.2f64.to_radians());
     let pos_h = b.pos_std.x.max(b.pos_std.y);
     Ok(InMotionStart {
-        state: NavState::new(t_s, pos, v_n, Euler { roll, pitch, yaw }),
+        state: NavState::new(
+            t_s,
+            pos,
+            v_n,
+            Euler {
+                roll,
+                pitch,
+                yaw: 0.0,
+            },
+        ),
         sample,
         pos_std: Vector3::new(pos_h, pos_h, b.pos_std.z),
         vel_std: Vector3::new(sigma_v, sigma_v, 2.0 * sigma_v)
             + Vector3::repeat(accel * VELOCITY_SPAN),
-        att_std: Vector3::new(tilt_std, tilt_std, course_std),
+        att_std: Vector3::new(tilt_std, tilt_std, std::f64::consts::PI),
         fixes: (i, j),
         speed: v_n.xy().norm(),
     })
 }
 
 /// Time over which the start's velocity is differenced from the fixes [s].
-const VELOCITY_SPAN: f64 = 2.0;
+pub const VELOCITY_SPAN: f64 = 2.0;
 
 #[cfg(test)]
 mod tests {

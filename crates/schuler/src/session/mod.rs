@@ -23,6 +23,7 @@
 pub mod aid;
 pub mod config;
 pub mod engine;
+pub mod heading_bank;
 pub mod output;
 pub mod start;
 mod vehicle;
@@ -32,6 +33,7 @@ pub use config::{
     BaroLoopConfig, ConfigError, Envelope, FilterConfig, MechanizationChoice, MechanizationConfig,
     MechanizationKind, RestConfig, RestSource, SessionConfig, VehicleConfig,
 };
+pub use heading_bank::{Chosen, HeadingBank};
 pub use output::{Decimator, Epoch, Event, FilterEpoch, Handover, Snapshot};
 pub use start::{Prior, Start};
 
