@@ -169,7 +169,9 @@ impl Outputs {
         Ok(())
     }
 
-    fn event(&mut self, e: Event) -> Result<()> {
+    /// Writes one event (an envelope warning to stderr, the filter's records to
+    /// `innovations.csv` and `rejected.csv`).
+    pub fn event(&mut self, e: Event) -> Result<()> {
         if let Event::Envelope { t, what } = &e {
             eprintln!(
                 "warning: at t = {t} s the solution left the physical envelope: {what} \
@@ -280,7 +282,7 @@ where
     }
     session.end_of_input();
     out.take(&mut session)?;
-    if n == 0 {
+    if n == 0 && session.integrated_to().is_none() {
         // Nothing was pushed: the session has no state to report.
         return failure.map_or(Ok(None), Err);
     }

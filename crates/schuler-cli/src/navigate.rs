@@ -17,7 +17,8 @@ use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
 use schuler::session::{
-    Aid, Finished, MechanizationConfig, Session, SessionConfig, SessionError, Start, Summary,
+    Aid, Finished, HeadingBank, MechanizationConfig, Session, SessionConfig, SessionError, Start,
+    Summary,
 };
 use std::path::{Path, PathBuf};
 
@@ -91,22 +92,32 @@ fn open<E: EarthModel>(
     aiding: Option<&Aiding>,
     start: Start,
 ) -> Result<(Session<E>, Outputs)> {
-    let out = &settings.out;
     let mut session =
         Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
-    let nav_name = aiding.map_or("nav.txt", |a| a.names.nav);
-    let writer = NavWriter::create_named(out, nav_name, settings.week, &earth)?;
-    let files = match aiding {
-        Some(a) => {
-            session = session.with_truth(a.report.truth_rows().to_vec());
-            for aid in aids(a) {
-                session.push(aid)?;
-            }
-            Some(FilterFiles::create(out, a.names.std, a.names.imu_err)?)
+    if let Some(a) = aiding {
+        session = session.with_truth(a.report.truth_rows().to_vec());
+        for aid in aids(a) {
+            session.push(aid)?;
         }
+    }
+    Ok((session, outputs(&earth, settings, aiding)?))
+}
+
+/// The outputs a run writes into `settings.out`: the navigation result and, aided,
+/// the filter's files.
+fn outputs<E: EarthModel>(
+    earth: &E,
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+) -> Result<Outputs> {
+    let out = &settings.out;
+    let nav_name = aiding.map_or("nav.txt", |a| a.names.nav);
+    let writer = NavWriter::create_named(out, nav_name, settings.week, earth)?;
+    let files = match aiding {
+        Some(a) => Some(FilterFiles::create(out, a.names.std, a.names.imu_err)?),
         None => None,
     };
-    Ok((session, Outputs::new(writer, files)))
+    Ok(Outputs::new(writer, files))
 }
 
 /// The facts of an aided run, with summary `s`, that the report states.
@@ -177,7 +188,19 @@ where
     I: Iterator<Item = Result<ImuSample, InputError>>,
 {
     let (session, outputs) = open(earth, settings, aiding, start)?;
-    let Some(driven) = drive(session, samples, outputs, &settings.out, on_sample)? else {
+    let driven = drive(session, samples, outputs, &settings.out, on_sample)?;
+    conclude(&earth, settings, aiding, driven)
+}
+
+/// The end of a run driven through [`drive`] (`None`: no sample at all): the aided
+/// run's files and report, the read error that stopped it if any, the summary.
+fn conclude<E: EarthModel>(
+    earth: &E,
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+    driven: Option<Driven>,
+) -> Result<RunSummary> {
+    let Some(driven) = driven else {
         bail!(
             "{}: no IMU sample in the requested time window",
             settings.imu.display()
@@ -191,7 +214,7 @@ where
         heading_settled,
     } = driven;
     let report_text = match (aiding, filter) {
-        (Some(a), Some(files)) => finish_aided(&earth, settings, a, files, &finished, failure)?,
+        (Some(a), Some(files)) => finish_aided(earth, settings, a, files, &finished, failure)?,
         _ => match failure {
             Some(e) => return Err(e),
             None => String::new(),
@@ -204,6 +227,63 @@ where
         heading_settled,
     })
 }
+
+/// As [`navigate`] with the heading unknown: a bank of `members` sessions from every
+/// `360°/members` of heading runs on the samples ([`schuler::session::HeadingBank`])
+/// until the most likely leads every member more than a sector away from it by
+/// [`BANK_MARGIN`] in log-likelihood (checked once a second), or `decide_after`
+/// seconds past the first sample; the most likely goes on. Returns the summary, the
+/// kept member's initial heading [rad], and the time the bank decided [s].
+#[allow(clippy::too_many_arguments)] // the run's inputs, as navigate's, plus the bank's two
+pub fn navigate_any_heading<E: EarthModel, I>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: &Aiding,
+    start: Start,
+    members: usize,
+    decide_after: f64,
+    mut samples: I,
+    on_sample: impl FnMut(u64),
+) -> Result<(RunSummary, f64, f64)>
+where
+    I: Iterator<Item = Result<ImuSample, InputError>>,
+{
+    let config = settings.session_config(Some(aiding));
+    let mut bank = HeadingBank::new(earth, config, start, members)
+        .map_err(named_flag)?
+        .with_truth(aiding.report.truth_rows());
+    for aid in aids(aiding) {
+        bank.push(aid)?;
+    }
+    let (mut t0, mut checked, mut decided) = (None, f64::NEG_INFINITY, f64::NAN);
+    for s in samples.by_ref() {
+        let s = s?;
+        bank.push_imu(s)?;
+        decided = s.t;
+        let since = s.t - *t0.get_or_insert(s.t);
+        if since >= decide_after {
+            break;
+        }
+        if since - checked >= 1.0 {
+            checked = since;
+            if bank.separated(BANK_MARGIN) {
+                break;
+            }
+        }
+    }
+    let chosen = bank.decide();
+    let mut out = outputs(&earth, settings, Some(aiding))?;
+    for e in chosen.events {
+        out.event(e)?;
+    }
+    let driven = drive(chosen.session, samples, out, &settings.out, on_sample)?;
+    let summary = conclude(&earth, settings, Some(aiding), driven)?;
+    Ok((summary, chosen.yaw0, decided))
+}
+
+/// Log-likelihood lead [nats] at which the heading bank decides: a likelihood ratio of
+/// e^20 ≈ 5e8 against every heading more than a sector away.
+pub const BANK_MARGIN: f64 = 20.0;
 
 /// Every aid of a run, as pushed: GNSS fixes, barometer readings, vehicle readings.
 fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {

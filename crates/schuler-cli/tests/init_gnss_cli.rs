@@ -53,3 +53,50 @@ fn a_drive_started_in_motion_matches_the_truth() {
     );
     assert!(worst < 1.0, "{worst}");
 }
+
+/// `--init gnss-any-heading` on the same drive: no course is used, a bank of twelve
+/// filters waits through the rest until the drive tells the headings apart, then the
+/// most likely goes on; the heading agrees with the truth as with the course start.
+#[test]
+fn a_drive_started_with_any_heading_matches_the_truth() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sim = common::simulate_drive(dir.path());
+    let out = dir.path().join("out");
+    let o = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--init", "gnss-any-heading", "--imu"])
+        .arg(sim.join("imu.txt"))
+        .arg("--gnss")
+        .arg(sim.join("gnss.txt"))
+        .args(["--lever-arm", "0.5,0,-1", "--imu-grade", "tactical"])
+        .args(["--output-rate", "1", "--no-report", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
+    assert!(
+        stdout.contains("heading unknown: a bank of 12 filters"),
+        "{stdout}"
+    );
+    let kept = stdout
+        .lines()
+        .find(|l| l.starts_with("heading bank: kept the filter started at"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let nav = common::read_rows(&out.join("nav.txt"));
+    let truth = common::read_rows(&sim.join("truth.nav"));
+    let at = |t: f64| {
+        truth
+            .iter()
+            .find(|r| (r[1] - t).abs() < 1e-6)
+            .expect("truth at the epoch")
+    };
+    let worst = nav
+        .iter()
+        .filter(|r| r[1] >= 180.0)
+        .map(|r| ((r[10] - at(r[1])[10] + 540.0).rem_euclid(360.0) - 180.0).abs())
+        .fold(0.0f64, f64::max);
+    eprintln!("{stdout}{kept}; largest heading error from 180 s {worst:.3} deg");
+    // The drive's heading is 10 deg: the member started at 0 deg is the nearest.
+    assert!(kept.contains("started at 0 deg"), "{kept}");
+    assert!(worst < 1.0, "{worst}");
+}

@@ -99,10 +99,12 @@ pub struct NavArgs {
     /// removed; --init-att is then not needed. Writes align.json beside nav.txt.
     #[arg(long)]
     pub align: bool,
-    /// How the run starts: `given` (default: --init-pos, --init-att) or `gnss`: in
+    /// How the run starts: `given` (default: --init-pos, --init-att); `gnss`: in
     /// motion, from the GNSS fixes alone (position and velocity from the fixes, heading
     /// from the course: a land vehicle driving forward along the IMU's x axis is
-    /// assumed; roll and pitch from the accelerometers); needs --gnss.
+    /// assumed; roll and pitch from the accelerometers); `gnss-any-heading`: the same
+    /// without the course, the heading found by a bank of filters (multicopters); both
+    /// need --gnss.
     #[arg(long, value_enum)]
     pub init: Option<InitChoice>,
     /// Run a KF-GINS configuration file (its paths, initial state, IMU noise and lever
@@ -154,6 +156,10 @@ pub enum InitChoice {
     Given,
     /// In motion, from the GNSS fixes (land vehicles driving forward).
     Gnss,
+    /// From the GNSS fixes with the heading unknown (any vehicle, multicopters too): a
+    /// bank of twelve filters from every 30° of heading until the data tell them
+    /// apart, the most likely kept.
+    GnssAnyHeading,
 }
 
 fn load_config(path: &Path) -> Result<NavConfig> {
@@ -282,11 +288,11 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
     };
     let align_on = args.align || cfg.align.unwrap_or(false);
     let init = args.init.or(cfg.init).unwrap_or_default();
-    if init == InitChoice::Gnss && align_on {
+    // In motion the fixes give the position and the course (or the bank) the attitude.
+    let in_motion = init != InitChoice::Given;
+    if in_motion && align_on {
         bail!("--init gnss starts in motion; --align starts at rest: give one of them");
     }
-    // In motion the fixes give the position and the course the attitude.
-    let in_motion = init == InitChoice::Gnss;
     let settings = NavSettings {
         imu: args
             .imu
@@ -373,24 +379,25 @@ fn align_first(
     Ok((Start::from_alignment(&a), samples[carrier..].to_vec()))
 }
 
-/// With `--init gnss`: the start in motion from the fixes and the IMU samples up to
-/// a few seconds past the first pair of fixes far enough apart
-/// ([`schuler::align::in_motion`]), printed; the filter's prior becomes its standard
-/// deviations. Returns the start and the samples from its carrier on.
-fn start_in_motion(
+/// With `--init gnss` or `gnss-any-heading`: the start in motion from the fixes and
+/// the IMU samples up to just past the fix it starts at ([`schuler::align::in_motion`]:
+/// the course's first long straight chord, or without a heading the first fix two
+/// seconds into the log), printed; the filter's prior becomes its standard deviations.
+/// Returns the start and the samples from its carrier on.
+fn start_from_fixes(
     settings: &NavSettings,
     reader: &mut ImuReader<std::io::BufReader<std::fs::File>>,
     aiding: Option<&mut Aiding>,
+    init: InitChoice,
 ) -> Result<(Start, Vec<ImuSample>)> {
-    use schuler::align::in_motion::{InMotionConfig, course_pair, start_in_motion};
-    let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
-        bail!("--init gnss needs GNSS fixes (--gnss FILE)");
+    use schuler::align::in_motion::{
+        InMotionConfig, VELOCITY_SPAN, course_pair, start_at_fix, start_in_motion,
     };
-    let cfg = InMotionConfig::default();
-    let earth = Wgs84;
-    let (_, j) = course_pair(&earth, &aiding.fixes, &cfg)
-        .with_context(|| format!("--init gnss: {}", settings.imu.display()))?;
-    let until = aiding.fixes[j].t + cfg.settle + cfg.level_window;
+    let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
+        bail!("--init {init:?} needs GNSS fixes (--gnss FILE)");
+    };
+    let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &aiding.fixes);
+    let context = || format!("--init gnss: {}", settings.imu.display());
     let first = match reader.next() {
         Some(s) => s?,
         None => bail!(
@@ -398,20 +405,40 @@ fn start_in_motion(
             settings.imu.display()
         ),
     };
-    let seconds = (until - first.t).max(0.0);
+    let i0 = fixes.partition_point(|f| f.t < first.t);
+    let j = match init {
+        InitChoice::Gnss => course_pair(&earth, fixes, &cfg).with_context(context)?.1,
+        _ => i0 + fixes[i0..].partition_point(|f| f.t < first.t + VELOCITY_SPAN),
+    };
+    let Some(fix) = fixes.get(j) else {
+        bail!("{}: no GNSS fix two seconds into the IMU data", context());
+    };
     let mut samples = vec![first];
-    samples.extend(crate::alignment::read_stage(reader, seconds)?);
-    let m = start_in_motion(&earth, &samples, &aiding.fixes, &cfg)
-        .with_context(|| format!("--init gnss: {}", settings.imu.display()))?;
+    let until = fix.t + cfg.settle + cfg.level_window;
+    samples.extend(crate::alignment::read_stage(
+        reader,
+        (until - first.t).max(0.0),
+    )?);
+    let m = match init {
+        InitChoice::Gnss => start_in_motion(&earth, &samples, fixes, &cfg),
+        _ => start_at_fix(&earth, &samples, fixes, i0, j, &cfg),
+    }
+    .with_context(context)?;
     let e = m.state.euler();
+    let heading = match init {
+        InitChoice::Gnss => format!(
+            "heading {:.2} ± {:.2} deg (the course: forward motion along the IMU's x axis assumed)",
+            e.heading_0_2pi().to_degrees(),
+            m.att_std.z.to_degrees()
+        ),
+        _ => format!("heading unknown: a bank of {BANK_MEMBERS} filters searches it"),
+    };
     println!(
-        "started in motion at t = {} s from the fixes at {} and {} s: {:.2} m/s, heading {:.2} ± {:.2} deg (the course: forward motion along the IMU's x axis assumed), roll {:.2} pitch {:.2} ± {:.2} deg",
+        "started in motion at t = {} s from the fixes at {} and {} s: {:.2} m/s, {heading}, roll {:.2} pitch {:.2} ± {:.2} deg",
         m.state.t,
-        aiding.fixes[m.fixes.0].t,
-        aiding.fixes[m.fixes.1].t,
+        fixes[m.fixes.0].t,
+        fixes[m.fixes.1].t,
         m.speed,
-        e.heading_0_2pi().to_degrees(),
-        m.att_std.z.to_degrees(),
         e.roll.to_degrees(),
         e.pitch.to_degrees(),
         m.att_std.x.to_degrees()
@@ -419,6 +446,84 @@ fn start_in_motion(
     let filter = &mut aiding.filter;
     *filter = Prior::from_motion(&m).apply_to(*filter);
     Ok((Start::from_motion(&m), samples[m.sample..].to_vec()))
+}
+
+/// Members of the heading bank of `--init gnss-any-heading` (every 30°).
+const BANK_MEMBERS: usize = 12;
+
+/// Longest the heading bank runs before it keeps its most likely member [s] (it
+/// decides earlier once the data tell the headings apart).
+const BANK_SECONDS: f64 = 600.0;
+
+/// Navigate on the settings' Earth model: from `start`, or with `any_heading` through
+/// the heading bank (printing its choice).
+fn navigate_on_earth<I>(
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+    start: Start,
+    any_heading: bool,
+    samples: I,
+    on_sample: impl FnMut(u64),
+) -> Result<RunSummary>
+where
+    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+{
+    fn run_on<E: schuler::earth::EarthModel, I>(
+        earth: E,
+        settings: &NavSettings,
+        aiding: Option<&Aiding>,
+        start: Start,
+        any_heading: bool,
+        samples: I,
+        on_sample: impl FnMut(u64),
+    ) -> Result<RunSummary>
+    where
+        I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+    {
+        match (aiding, any_heading) {
+            (Some(a), true) => {
+                let (summary, yaw0, decided) = crate::navigate::navigate_any_heading(
+                    earth,
+                    settings,
+                    a,
+                    start,
+                    BANK_MEMBERS,
+                    BANK_SECONDS,
+                    samples,
+                    on_sample,
+                )?;
+                println!(
+                    "heading bank: kept the filter started at {:.0} deg, decided at t = {decided} s",
+                    yaw0.to_degrees().rem_euclid(360.0)
+                );
+                Ok(summary)
+            }
+            _ => navigate(earth, settings, aiding, start, samples, on_sample),
+        }
+    }
+    match settings.earth {
+        EarthChoice::Wgs84 => run_on(
+            Wgs84,
+            settings,
+            aiding,
+            start,
+            any_heading,
+            samples,
+            on_sample,
+        ),
+        EarthChoice::Sphere | EarthChoice::SphereFixed => {
+            let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
+            run_on(
+                sphere,
+                settings,
+                aiding,
+                start,
+                any_heading,
+                samples,
+                on_sample,
+            )
+        }
+    }
 }
 
 /// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
@@ -456,34 +561,27 @@ pub fn run(args: NavArgs) -> Result<()> {
     let bar = progress_bar(&settings.imu);
     let (start, head) = match (align, init) {
         (true, _) => align_first(&settings, &alignment, &mut reader, aiding.as_mut(), &bar)?,
-        (false, InitChoice::Gnss) => start_in_motion(&settings, &mut reader, aiding.as_mut())?,
         (false, InitChoice::Given) => (settings.start(), Vec::new()),
+        (false, _) => start_from_fixes(&settings, &mut reader, aiding.as_mut(), init)?,
     };
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
     let samples = head.into_iter().map(Ok).chain(&mut reader);
-    let summary = match settings.earth {
-        EarthChoice::Wgs84 => {
-            navigate(Wgs84, &settings, aiding.as_ref(), start, samples, on_sample)
-        }
-        EarthChoice::Sphere | EarthChoice::SphereFixed => {
-            let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
-            navigate(
-                sphere,
-                &settings,
-                aiding.as_ref(),
-                start,
-                samples,
-                on_sample,
-            )
-        }
-    }?;
+    let any_heading = init == InitChoice::GnssAnyHeading;
+    let summary = navigate_on_earth(
+        &settings,
+        aiding.as_ref(),
+        start,
+        any_heading,
+        samples,
+        on_sample,
+    )?;
     bar.set_position(reader.bytes_read());
     bar.finish_and_clear();
     let secs = started.elapsed().as_secs_f64();
     match &aiding {
         Some(a) => {
-            if init == InitChoice::Gnss {
+            if init != InitChoice::Given {
                 print_heading_settled(&summary);
             }
             print_aided(&settings, a, &summary, secs)

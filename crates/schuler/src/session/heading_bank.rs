@@ -84,6 +84,20 @@ impl<E: EarthModel> HeadingBank<E> {
         Ok(Self { members })
     }
 
+    /// Every member's snapshots carry NEES against `truth`
+    /// ([`Session::with_truth`]).
+    pub fn with_truth(self, truth: &[crate::analysis::errors::NavRecord]) -> Self {
+        let members = self
+            .members
+            .into_iter()
+            .map(|m| Member {
+                session: m.session.with_truth(truth.to_vec()),
+                ..m
+            })
+            .collect();
+        Self { members }
+    }
+
     /// Push a sample into every member and score what they tested.
     pub fn push_imu(&mut self, s: ImuSample) -> Result<(), SessionError> {
         for m in &mut self.members {
@@ -114,6 +128,28 @@ impl<E: EarthModel> HeadingBank<E> {
             .iter()
             .map(|m| (m.yaw, m.log_likelihood))
             .collect()
+    }
+
+    /// Whether the data have told the headings apart: the most likely member leads
+    /// every member more than one sector away from it by `margin` in log-likelihood
+    /// (its neighbours may stay close: the true heading can lie between two).
+    pub fn separated(&self, margin: f64) -> bool {
+        let n = self.members.len();
+        let Some(best) = (0..n).max_by(|&a, &b| {
+            self.members[a]
+                .log_likelihood
+                .total_cmp(&self.members[b].log_likelihood)
+        }) else {
+            return false;
+        };
+        let far = (0..n).filter(|&k| {
+            let d = (k + n - best) % n;
+            d > 1 && d < n - 1
+        });
+        let rival = far
+            .map(|k| self.members[k].log_likelihood)
+            .fold(f64::NEG_INFINITY, f64::max);
+        self.members[best].log_likelihood - rival > margin
     }
 
     /// Keep the most likely member.
