@@ -198,10 +198,10 @@ impl Outputs {
                 };
                 (k.t, format!("{},{},{why},,\n", k.t, k.kind))
             }
-            Event::GateReset { t } => (
+            Event::GateReset { t, nis } => (
                 t,
                 format!(
-                    "{t},gnss_position,accepted without the gate after consecutive refusals (filter reset),,\n"
+                    "{t},gnss_position,accepted without the gate after consecutive refusals (filter reset),{nis},\n"
                 ),
             ),
             Event::Late {
@@ -289,10 +289,26 @@ where
     if failure.is_some()
         && let Some(e) = session.epoch_now()
         && e.state.t != out.last_written
+        && e.state.pos.lat.is_finite()
+        && e.state.v_n.iter().all(|x| x.is_finite())
     {
         out.epoch(&e)?;
     }
-    let finished = session.finish()?;
+    let finished = match session.finish() {
+        Ok(f) => f,
+        Err(e) => {
+            // What was written stays whole: the files are closed before the error.
+            let epochs = out.nav.finish()?;
+            if let Some(files) = out.filter {
+                files.finish(dir)?;
+            }
+            return Err(anyhow::Error::new(e).context(format!(
+                "{epochs} epochs up to t = {} were written to {}",
+                out.last_written,
+                dir.display()
+            )));
+        }
+    };
     let epochs = out.nav.finish()?;
     let failure = failure.map(|e| {
         e.context(format!(

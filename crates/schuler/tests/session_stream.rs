@@ -299,3 +299,60 @@ fn leaving_the_envelope_is_reported_once() {
     assert!(low.starts_with("height -2000.0 m below -1000 m"), "{low}");
     assert!(fast.starts_with("speed 12"), "{fast}");
 }
+
+/// The gate's reset after five refusals in a row accepts a fix the filter has lost
+/// track of (here ten in a row 60 m off: 120 standard deviations, a jump the gate
+/// refuses) but never an impossible one (ten 10 km off: 20,000 standard deviations,
+/// beyond the reset's 1000); a reset is logged with its NIS.
+#[test]
+fn the_gate_reset_refuses_impossible_fixes() {
+    let log = log();
+    let run_with_jump = |jump: f64| {
+        let aids: Vec<Aid> = log
+            .aids
+            .iter()
+            .map(|a| match a {
+                Aid::Gnss(f) if f.t > 100.0 && f.t <= 110.0 => {
+                    let mut f = *f;
+                    f.pos.lat += jump / 6_378_137.0;
+                    Aid::Gnss(f)
+                }
+                other => *other,
+            })
+            .collect();
+        let inputs: Vec<Input> = aids
+            .iter()
+            .map(|a| Input::Aid(*a))
+            .chain(log.imu.iter().map(|s| Input::Imu(*s)))
+            .collect();
+        run(log.noise, log.start, 0.0, &inputs)
+    };
+    let resets = |r: &Run| -> Vec<(f64, f64)> {
+        r.events
+            .iter()
+            .filter_map(|e| match e {
+                Event::GateReset { t, nis } => Some((*t, *nis)),
+                _ => None,
+            })
+            .collect()
+    };
+    let lost = run_with_jump(60.0);
+    let impossible = run_with_jump(10_000.0);
+    println!(
+        "resets 60 m: {:?}; 10 km: {:?}",
+        resets(&lost),
+        resets(&impossible)
+    );
+    // 60 m off: the sixth fix in a row is let through (NIS ≈ (60/0.5)²·…, far above
+    // the gate, far below the bound of 1000 sigma per axis).
+    let r = resets(&lost);
+    assert!(
+        matches!(r.first(), Some(&(t, nis)) if t == 106.0 && nis > 100.0 && nis < 3e6),
+        "{r:?}"
+    );
+    // 10 km off: all ten refused; the first good fix after them is accepted by the
+    // reset with a small NIS.
+    let r = resets(&impossible);
+    assert!(r.iter().all(|&(t, nis)| t > 110.0 && nis < 100.0), "{r:?}");
+    assert_eq!(impossible.summary.counts.rejected, 10);
+}

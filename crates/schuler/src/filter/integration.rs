@@ -42,6 +42,12 @@ pub struct GnssFix {
     pub vel: Option<(Vector3<f64>, Vector3<f64>)>,
 }
 
+/// The gate's reset after consecutive refusals accepts a GNSS position only within
+/// this many standard deviations per degree of freedom of the prediction (the filter
+/// may have lost track after a long outage, but an innovation of a thousand standard
+/// deviations is a wrong fix, not a lost track).
+pub const RESET_MAX_SIGMA: f64 = 1000.0;
+
 /// Filter settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IntegrationConfig {
@@ -242,8 +248,9 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     pub innovations: Vec<Innovation>,
     /// Counters.
     pub counts: Counts,
-    /// Times at which the gate was bypassed after `reset_after` refusals in a row.
-    pub gate_resets: Vec<f64>,
+    /// Times at which the gate was bypassed after `reset_after` refusals in a row, with
+    /// the normalized innovation squared of the fix then accepted.
+    pub gate_resets: Vec<(f64, f64)>,
     consecutive_rejections: u32,
     /// The record for the smoother, when smoothing.
     smoother: Option<super::smoother::SmootherLog>,
@@ -623,7 +630,13 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         let reset = position
             && self.cfg.reset_after > 0
             && self.consecutive_rejections >= self.cfg.reset_after;
-        let gate = if reset { Gate::Off } else { self.cfg.gate };
+        // A reset still refuses the impossible: an innovation beyond
+        // RESET_MAX_SIGMA standard deviations per degree of freedom.
+        let gate = if reset {
+            Gate::Bound(RESET_MAX_SIGMA * RESET_MAX_SIGMA * m.z.len() as f64)
+        } else {
+            self.cfg.gate
+        };
         let outcome = self.kf.update(&m.z, &m.h, &m.r, gate);
         let (nis, s_diag) = match &outcome {
             Ok(u) => (u.nis, &u.s_diag),
@@ -640,7 +653,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         match outcome {
             Ok(u) => {
                 if reset {
-                    self.gate_resets.push(t);
+                    self.gate_resets.push((t, u.nis));
                 }
                 if position {
                     self.consecutive_rejections = 0;

@@ -18,6 +18,9 @@ pub enum Gate {
     Off,
     /// Reject above the quantile at this significance level (e.g. 0.001).
     Level(f64),
+    /// Reject only a normalized innovation squared above this bound (physically
+    /// impossible innovations, e.g. thousands of standard deviations).
+    Bound(f64),
 }
 
 /// An accepted update.
@@ -105,15 +108,19 @@ impl Kalman {
         };
         let s_inv_z = chol.solve(z);
         let nis = z.dot(&s_inv_z);
-        if let Gate::Level(alpha) = gate {
-            let threshold = chi_square_quantile(z.len(), 1.0 - alpha);
-            if nis > threshold || !nis.is_finite() {
-                return Err(Rejection {
-                    nis,
-                    threshold,
-                    s_diag,
-                });
-            }
+        let threshold = match gate {
+            Gate::Off => None,
+            Gate::Level(alpha) => Some(chi_square_quantile(z.len(), 1.0 - alpha)),
+            Gate::Bound(b) => Some(b),
+        };
+        if let Some(threshold) = threshold
+            && (nis > threshold || !nis.is_finite())
+        {
+            return Err(Rejection {
+                nis,
+                threshold,
+                s_diag,
+            });
         }
         // K = P Hᵀ S⁻¹ (S symmetric): solve S Kᵀ = H P.
         let k = chol.solve(&pht.transpose()).transpose();

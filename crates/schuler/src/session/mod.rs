@@ -92,6 +92,18 @@ pub enum SessionError {
     /// No IMU sample was pushed.
     #[error("no IMU sample was pushed: nothing to navigate")]
     NoImu,
+    /// The solution stopped being a number (an input far outside what the sensors can
+    /// read, or a diverged filter); nothing after it is computed.
+    #[error(
+        "the solution is not finite at t = {t} s (after the sample ending then; last finite output at {last_good} s): \
+         an IMU sample or an aid far outside the sensors' range?"
+    )]
+    NotFinite {
+        /// The output time at which it was found [s].
+        t: f64,
+        /// The last output time with a finite state [s] (NaN if none).
+        last_good: f64,
+    },
 }
 
 /// What a session did, at its end.
@@ -181,6 +193,9 @@ struct Loop {
     ended: bool,
     /// Which envelope bounds were crossed (low height, high height, speed).
     left_envelope: [bool; 3],
+    /// The last output time with a finite state, and the failure once it is not.
+    last_good: f64,
+    failure: Option<SessionError>,
 }
 
 /// A navigation session (module doc).
@@ -231,6 +246,8 @@ impl<E: EarthModel> Session<E> {
                 nis: (0.0, 0),
                 ended: false,
                 left_envelope: [false; 3],
+                last_good: f64::NAN,
+                failure: None,
                 cfg: config,
             },
         })
@@ -252,6 +269,9 @@ impl<E: EarthModel> Session<E> {
     /// Push the next IMU sample (times strictly increasing). Samples older than the
     /// newest by the reorder window or more are integrated now.
     pub fn push_imu(&mut self, s: ImuSample) -> Result<(), SessionError> {
+        if let Some(e) = &self.run.failure {
+            return Err(e.clone());
+        }
         if !(s.t.is_finite()
             && s.dt.is_finite()
             && s.dtheta.iter().all(|x| x.is_finite())
@@ -271,17 +291,20 @@ impl<E: EarthModel> Session<E> {
         let window = self.run.cfg.reorder_window;
         if window == 0.0 && self.run.imu.is_empty() {
             self.integrate(&s);
-            return Ok(());
-        }
-        self.run.imu.push_back(s);
-        while let Some(&front) = self.run.imu.front() {
-            if s.t - front.t < window {
-                break;
+        } else {
+            self.run.imu.push_back(s);
+            while let Some(&front) = self.run.imu.front() {
+                if s.t - front.t < window || self.run.failure.is_some() {
+                    break;
+                }
+                self.run.imu.pop_front();
+                self.integrate(&front);
             }
-            self.run.imu.pop_front();
-            self.integrate(&front);
         }
-        Ok(())
+        match &self.run.failure {
+            Some(e) => Err(e.clone()),
+            None => Ok(()),
+        }
     }
 
     /// Push an aid (in arrival order; see [`aid`] for when it is late).
@@ -346,6 +369,9 @@ impl<E: EarthModel> Session<E> {
             return;
         }
         while let Some(s) = self.run.imu.pop_front() {
+            if self.run.failure.is_some() {
+                break;
+            }
             self.integrate(&s);
         }
         self.run.ended = true;
@@ -388,8 +414,17 @@ impl<E: EarthModel> Session<E> {
         let Some(core) = self.core else {
             return Err(SessionError::NoImu);
         };
-        let run = self.run;
+        if let Some(e) = self.run.failure {
+            return Err(e);
+        }
         let (last, ..) = core.read_out();
+        if !state_is_finite(&last) {
+            return Err(SessionError::NotFinite {
+                t: last.t,
+                last_good: self.run.last_good,
+            });
+        }
+        let run = self.run;
         let end = match &core {
             Core::FilterNed(i) => filter_end(i, &run.cfg),
             Core::FilterWander(i) => filter_end(i, &run.cfg),
@@ -460,6 +495,16 @@ impl<E: EarthModel> Session<E> {
             run.emit(core);
         }
     }
+}
+
+/// Whether every number of `s` is finite.
+fn state_is_finite(s: &NavState) -> bool {
+    let q = s.q_bn.as_ref();
+    [
+        s.pos.lat, s.pos.lon, s.pos.h, s.v_n.x, s.v_n.y, s.v_n.z, q.w, q.i, q.j, q.k,
+    ]
+    .iter()
+    .all(|x| x.is_finite())
 }
 
 /// The epoch a running navigation reports now.
@@ -611,6 +656,14 @@ impl Loop {
             _ => {}
         }
         let epoch = epoch_of(core);
+        if !state_is_finite(&epoch.state) {
+            self.failure = Some(SessionError::NotFinite {
+                t: epoch.state.t,
+                last_good: self.last_good,
+            });
+            return;
+        }
+        self.last_good = epoch.state.t;
         self.check_envelope(&epoch.state);
         self.epochs.push_back(epoch);
     }
@@ -718,8 +771,12 @@ impl Loop {
         }
         if !integ.gate_resets.is_empty() {
             self.gate_resets += integ.gate_resets.len() as u64;
-            self.events
-                .extend(integ.gate_resets.drain(..).map(|t| Event::GateReset { t }));
+            self.events.extend(
+                integ
+                    .gate_resets
+                    .drain(..)
+                    .map(|(t, nis)| Event::GateReset { t, nis }),
+            );
         }
     }
 

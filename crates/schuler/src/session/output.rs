@@ -88,6 +88,8 @@ pub enum Event {
     GateReset {
         /// Time [s].
         t: f64,
+        /// Its normalized innovation squared.
+        nis: f64,
     },
     /// A measurement outside the IMU data.
     Skipped(Skipped),
