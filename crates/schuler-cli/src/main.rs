@@ -15,7 +15,8 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 #[allow(clippy::large_enum_variant)] // parsed once per run
 enum Command {
-    /// Free-inertial navigation of an IMU log (KF-GINS text or CSV).
+    /// Navigation of an IMU log (KF-GINS text or CSV): free-inertial or aided (GNSS,
+    /// barometer, vehicle aids), from a given start, an alignment or in motion.
     Nav(schuler_cli::commands::nav::NavArgs),
     /// Initial alignment at rest: gyrocompassing, then the Kalman filter on invariants.
     Align(schuler_cli::commands::align::Args),
