@@ -4,23 +4,32 @@
 
 mod common;
 
-#[test]
-fn a_drive_started_in_motion_matches_the_truth() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let sim = common::simulate_drive(dir.path());
-    let out = dir.path().join("out");
+/// `schuler nav --init INIT` on the simulated drive in `dir` (output at 1 Hz into
+/// `dir/out`): its stdout, and the drive's folder.
+fn nav_from_fixes(dir: &std::path::Path, init: &str) -> (String, std::path::PathBuf) {
+    let sim = common::simulate_drive(dir);
     let o = assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
-        .args(["nav", "--init", "gnss", "--imu"])
+        .args(["nav", "--init", init, "--imu"])
         .arg(sim.join("imu.txt"))
         .arg("--gnss")
         .arg(sim.join("gnss.txt"))
         .args(["--lever-arm", "0.5,0,-1", "--imu-grade", "tactical"])
         .args(["--output-rate", "1", "--no-report", "--out"])
-        .arg(&out)
+        .arg(dir.join("out"))
         .assert()
         .success();
-    let stdout = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
+    (
+        String::from_utf8_lossy(&o.get_output().stdout).into_owned(),
+        sim,
+    )
+}
+
+#[test]
+fn a_drive_started_in_motion_matches_the_truth() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (stdout, sim) = nav_from_fixes(dir.path(), "gnss");
+    let out = dir.path().join("out");
     assert!(stdout.contains("started in motion at t = "), "{stdout}");
     assert!(
         stdout.contains("heading converged (std below 1 deg)"),
@@ -60,20 +69,8 @@ fn a_drive_started_in_motion_matches_the_truth() {
 #[test]
 fn a_drive_started_with_any_heading_matches_the_truth() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let sim = common::simulate_drive(dir.path());
+    let (stdout, sim) = nav_from_fixes(dir.path(), "gnss-any-heading");
     let out = dir.path().join("out");
-    let o = assert_cmd::Command::cargo_bin("schuler")
-        .expect("binary")
-        .args(["nav", "--init", "gnss-any-heading", "--imu"])
-        .arg(sim.join("imu.txt"))
-        .arg("--gnss")
-        .arg(sim.join("gnss.txt"))
-        .args(["--lever-arm", "0.5,0,-1", "--imu-grade", "tactical"])
-        .args(["--output-rate", "1", "--no-report", "--out"])
-        .arg(&out)
-        .assert()
-        .success();
-    let stdout = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
     assert!(
         stdout.contains("heading unknown: a bank of 12 filters"),
         "{stdout}"

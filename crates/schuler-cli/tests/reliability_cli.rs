@@ -28,15 +28,11 @@ fn corrupted(dir: &std::path::Path, row: usize, dv: &str) -> std::path::PathBuf 
     path
 }
 
-/// One row with a velocity increment of 1e20 m/s (the reproducer, which
-/// ended "final: lat NaN" with exit 0): an error naming the time; nav.txt whole-lined
-/// without a NaN.
-#[test]
-fn a_huge_increment_stops_the_run_without_writing_nan() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let imu = corrupted(dir.path(), 5000, "1e20");
-    let out = dir.path().join("out");
-    let o = assert_cmd::Command::cargo_bin("schuler")
+/// `schuler nav` of the drive9min log with one row's velocity increment `dv` into
+/// `dir/out` (the layout check off, to reach the navigation).
+fn nav_with(dir: &std::path::Path, dv: &str) -> assert_cmd::assert::Assert {
+    let imu = corrupted(dir, 5000, dv);
+    assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .args(["nav", "--no-layout-check", "--imu"])
         .arg(&imu)
@@ -47,9 +43,18 @@ fn a_huge_increment_stops_the_run_without_writing_nan() {
             "0,0,10",
         ])
         .args(["--output-rate", "10", "--out"])
-        .arg(&out)
+        .arg(dir.join("out"))
         .assert()
-        .failure();
+}
+
+/// One row with a velocity increment of 1e20 m/s (the reproducer, which
+/// ended "final: lat NaN" with exit 0): an error naming the time; nav.txt whole-lined
+/// without a NaN.
+#[test]
+fn a_huge_increment_stops_the_run_without_writing_nan() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = nav_with(dir.path(), "1e20").failure();
+    let out = dir.path().join("out");
     let stderr = String::from_utf8_lossy(&o.get_output().stderr).into_owned();
     assert!(
         stderr.contains("the solution is not finite at t = 50.1 s"),
@@ -65,21 +70,7 @@ fn a_huge_increment_stops_the_run_without_writing_nan() {
 #[test]
 fn leaving_the_envelope_is_warned_and_the_run_finishes() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let imu = corrupted(dir.path(), 5000, "2000");
-    let o = assert_cmd::Command::cargo_bin("schuler")
-        .expect("binary")
-        .args(["nav", "--no-layout-check", "--imu"])
-        .arg(&imu)
-        .args([
-            "--init-pos",
-            "45.0712345678,7.6812345678,245",
-            "--init-att",
-            "0,0,10",
-        ])
-        .args(["--output-rate", "10", "--out"])
-        .arg(dir.path().join("out"))
-        .assert()
-        .success();
+    let o = nav_with(dir.path(), "2000").success();
     let stderr = String::from_utf8_lossy(&o.get_output().stderr).into_owned();
     assert!(
         stderr.contains("at t = 50.1 s the solution left the physical envelope: speed"),

@@ -455,32 +455,43 @@ const BANK_MEMBERS: usize = 12;
 /// decides earlier once the data tell the headings apart).
 const BANK_SECONDS: f64 = 600.0;
 
-/// Navigate on the settings' Earth model: from `start`, or with `any_heading` through
-/// the heading bank (printing its choice).
-fn navigate_on_earth<I>(
-    settings: &NavSettings,
-    aiding: Option<&Aiding>,
+/// What a run starts from: the settings, the aiding, the start, and whether the
+/// heading is searched by the bank.
+struct Begin<'a> {
+    settings: &'a NavSettings,
+    aiding: Option<&'a Aiding>,
     start: Start,
     any_heading: bool,
-    samples: I,
-    on_sample: impl FnMut(u64),
-) -> Result<RunSummary>
-where
-    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
-{
-    fn run_on<E: schuler::earth::EarthModel, I>(
+}
+
+impl Begin<'_> {
+    /// Navigate on the settings' Earth model: from the start, or through the heading
+    /// bank (printing its choice).
+    fn navigate<I>(&self, samples: I, on_sample: impl FnMut(u64)) -> Result<RunSummary>
+    where
+        I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+    {
+        match self.settings.earth {
+            EarthChoice::Wgs84 => self.navigate_on(Wgs84, samples, on_sample),
+            EarthChoice::Sphere | EarthChoice::SphereFixed => {
+                let rotating = self.settings.earth == EarthChoice::Sphere;
+                self.navigate_on(Sphere::textbook(rotating), samples, on_sample)
+            }
+        }
+    }
+
+    /// [`Begin::navigate`] on `earth`.
+    fn navigate_on<E: schuler::earth::EarthModel, I>(
+        &self,
         earth: E,
-        settings: &NavSettings,
-        aiding: Option<&Aiding>,
-        start: Start,
-        any_heading: bool,
         samples: I,
         on_sample: impl FnMut(u64),
     ) -> Result<RunSummary>
     where
         I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
     {
-        match (aiding, any_heading) {
+        let (settings, start) = (self.settings, self.start);
+        match (self.aiding, self.any_heading) {
             (Some(a), true) => {
                 let (summary, yaw0, decided) = crate::navigate::navigate_any_heading(
                     earth,
@@ -498,30 +509,7 @@ where
                 );
                 Ok(summary)
             }
-            _ => navigate(earth, settings, aiding, start, samples, on_sample),
-        }
-    }
-    match settings.earth {
-        EarthChoice::Wgs84 => run_on(
-            Wgs84,
-            settings,
-            aiding,
-            start,
-            any_heading,
-            samples,
-            on_sample,
-        ),
-        EarthChoice::Sphere | EarthChoice::SphereFixed => {
-            let sphere = Sphere::textbook(settings.earth == EarthChoice::Sphere);
-            run_on(
-                sphere,
-                settings,
-                aiding,
-                start,
-                any_heading,
-                samples,
-                on_sample,
-            )
+            _ => navigate(earth, settings, self.aiding, start, samples, on_sample),
         }
     }
 }
@@ -567,15 +555,13 @@ pub fn run(args: NavArgs) -> Result<()> {
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
     let samples = head.into_iter().map(Ok).chain(&mut reader);
-    let any_heading = init == InitChoice::GnssAnyHeading;
-    let summary = navigate_on_earth(
-        &settings,
-        aiding.as_ref(),
+    let begin = Begin {
+        settings: &settings,
+        aiding: aiding.as_ref(),
         start,
-        any_heading,
-        samples,
-        on_sample,
-    )?;
+        any_heading: init == InitChoice::GnssAnyHeading,
+    };
+    let summary = begin.navigate(samples, on_sample)?;
     bar.set_position(reader.bytes_read());
     bar.finish_and_clear();
     let secs = started.elapsed().as_secs_f64();
