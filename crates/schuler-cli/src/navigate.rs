@@ -220,12 +220,57 @@ fn conclude<E: EarthModel>(
             None => String::new(),
         },
     };
+    if let Some(a) = aiding {
+        check_clocks(settings, a, &finished.summary)?;
+    }
     Ok(RunSummary {
         nav: finished.summary,
         epochs,
         report_text,
         heading_settled,
     })
+}
+
+/// The IMU's and the GNSS fixes' time spans against each other, after the run: no
+/// fix inside the IMU's span is an error (nothing aided the run: two clocks apart, a
+/// UNIX-time GNSS log against an IMU clock starting at 0) that shows both spans and
+/// the offset aligning their starts; fixes partly outside it a warning.
+fn check_clocks(settings: &NavSettings, a: &Aiding, s: &Summary) -> Result<()> {
+    let (Some(first), Some(last)) = (a.fixes.first(), a.fixes.last()) else {
+        return Ok(());
+    };
+    let inside = a
+        .fixes
+        .iter()
+        .filter(|f| f.t >= s.t_first && f.t <= s.t_last)
+        .count();
+    let spans = format!(
+        "the IMU samples span t = {} .. {} s ({}), the GNSS fixes t = {} .. {} s",
+        s.t_first,
+        s.t_last,
+        settings.imu.display(),
+        first.t,
+        last.t
+    );
+    if inside == 0 {
+        bail!(
+            "{spans}: no fix falls inside the IMU's span, so nothing aided the run (its \
+             free-inertial result is in {}). Two clocks apart? An offset of {:+} s on the \
+             GNSS stamps (or {:+} s on the IMU's) aligns their starts (--gnss-time-offset, \
+             --imu-time-offset)",
+            settings.out.display(),
+            s.t_first - first.t,
+            first.t - s.t_first
+        );
+    }
+    if inside < a.fixes.len() {
+        eprintln!(
+            "warning: {spans}: {} of {} fixes fall outside the IMU's span and are not used",
+            a.fixes.len() - inside,
+            a.fixes.len()
+        );
+    }
+    Ok(())
 }
 
 /// As [`navigate`] with the heading unknown: a bank of `members` sessions from every

@@ -77,3 +77,51 @@ fn leaving_the_envelope_is_warned_and_the_run_finishes() {
         "{stderr}"
     );
 }
+
+/// A GNSS log on another clock (the rover: the IMU's clock started at 0, the
+/// GNSS log used UNIX time): no fix falls inside the IMU's span; the run says so with
+/// both spans and the offset that aligns their starts, and fails.
+#[test]
+fn gnss_on_another_clock_is_an_error_with_the_offset() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = common::test_data("drive9min");
+    let imu = dir.path().join("IMU.txt");
+    std::fs::write(&imu, common::unxz(&data.join("IMU.txt.xz"))).expect("write");
+    let unix: String = std::fs::read_to_string(data.join("GNSS.txt"))
+        .expect("read")
+        .lines()
+        .map(|l| {
+            let (t, rest) = l.trim().split_once(char::is_whitespace).expect("columns");
+            let t: f64 = t.parse().expect("time");
+            format!("{} {rest}\n", t + 1_764_000_000.0)
+        })
+        .collect();
+    let gnss = dir.path().join("GNSS_unix.txt");
+    std::fs::write(&gnss, unix).expect("write");
+    let o = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--imu"])
+        .arg(&imu)
+        .arg("--gnss")
+        .arg(&gnss)
+        .args([
+            "--init-pos",
+            "45.0712345678,7.6812345678,245",
+            "--init-att",
+            "0,0,10",
+        ])
+        .args(["--no-report", "--out"])
+        .arg(dir.path().join("out"))
+        .assert()
+        .failure();
+    let stderr = String::from_utf8_lossy(&o.get_output().stderr).into_owned();
+    assert!(
+        stderr.contains("no fix falls inside the IMU's span"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("the GNSS fixes t = 1764000000"), "{stderr}");
+    assert!(
+        stderr.contains("An offset of -1763999999.99 s on the GNSS stamps"),
+        "{stderr}"
+    );
+}
