@@ -23,10 +23,11 @@
 //!
 //! Time is GPS seconds of week, continued across week rollovers from the first fix's
 //! week: the RMC date and the UTC time of day plus the leap seconds in force that day
-//! ([`super::gps_time`]: 18 s since 2017-01-01). An epoch without its own RMC takes the
-//! date of the last dated epoch (or the first one, for epochs before it), a day later or
-//! earlier where the time of day has wrapped past midnight. A log without any RMC date
-//! gives UTC seconds of day, continued across midnight, with a warning.
+//! (the leap-second table of `gps_time.rs`: 18 s since 2017-01-01). An epoch without
+//! its own RMC takes the date of the last dated epoch (or the first one, for epochs
+//! before it), a day later or earlier where the time of day has wrapped past midnight.
+//! A log without any RMC date gives UTC seconds of day, continued across midnight, with
+//! a warning.
 //!
 //! A bad sentence (checksum mismatch, malformed field, not ASCII, a GGA with a fix but
 //! no position) is counted and skipped, never fatal; epochs whose time does not

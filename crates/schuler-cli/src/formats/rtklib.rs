@@ -30,9 +30,9 @@
 //!   (positive) standard deviations it takes `--gnss-vel-std` on each axis.
 //!
 //! Other columns (`ns`, `age(s)`, `ratio`, the geodetic cross terms) are not read.
-//! Time is GPS seconds of week (UTC and JST plus the leap seconds,
-//! [`super::gps_time`]), continued across week rollovers from the first fix's week.
-//! Errors name the file, the line and the column.
+//! Time is GPS seconds of week (UTC and JST plus the leap seconds of the table in
+//! `gps_time.rs`), continued across week rollovers from the first fix's week. Errors
+//! name the file, the line and the column.
 
 use super::error::{InputError, InputErrorKind, quote_field};
 use super::gnss::{
