@@ -8,6 +8,7 @@ pub mod record;
 pub mod report;
 pub mod vehicle;
 
+use crate::formats::gnss::{GnssFormat, GnssQuality, GnssReadOptions, read_gnss_log};
 use crate::options::{Triple, quantity};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
@@ -82,18 +83,39 @@ pub struct OutageTest {
 #[derive(clap::Args, Debug, Default, Clone, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AidingOptions {
-    /// GNSS position log: KF-GINS text (t lat lon h std_n std_e std_d [vn ve vd
-    /// std_vn std_ve std_vd], whose velocities are then used) or CSV whose header names
-    /// t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m (as `schuler simulate`'s gnss.csv;
-    /// its velocity columns are used only through --gnss-vel, its outlier flag never).
+    /// GNSS position log: KF-GINS text (t lat lon h [std_n std_e std_d [vn ve vd
+    /// std_vn std_ve std_vd]], whose velocities are then used), CSV whose header names
+    /// t,lat_deg,lon_deg,h_m[,std_n_m,std_e_m,std_d_m] (as `schuler simulate`'s gnss.csv;
+    /// its velocity columns are used only through --gnss-vel, its outlier flag never),
+    /// an NMEA 0183 log (GGA, RMC, VTG, GST) or an RTKLIB solution (.pos); told by the
+    /// content or by --gnss-format.
     #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub gnss: Option<PathBuf>,
+    /// Format of --gnss (default auto: NMEA sentences, an RTKLIB `%` column header, else
+    /// text).
+    #[arg(long, value_name = "FORMAT")]
+    pub gnss_format: Option<GnssFormat>,
+    /// Position standard deviations north, east, down [m] for GNSS fixes whose file
+    /// gives none (4-column text, CSV without std columns, NMEA without GST, RTKLIB
+    /// without or with zero sdn sde sdu).
+    #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
+    pub gnss_std: Option<Triple>,
+    /// Drop NMEA and RTKLIB fixes of a lower quality: single (default, all kept),
+    /// dgps, float (PPP too) or fix.
+    #[arg(long, value_name = "QUALITY")]
+    pub gnss_min_quality: Option<GnssQuality>,
+    /// Added to every GNSS time after reading (e.g. `-18 s` to put GPS seconds of week
+    /// onto an IMU clock in UTC; NMEA and RTKLIB times are GPS seconds of week, NMEA
+    /// without a date UTC seconds of day).
+    #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    pub gnss_time_offset: Option<String>,
     /// GNSS velocity log matched to the fixes by time: text t vn ve vd [std_vn std_ve
     /// std_vd] or CSV naming t,vn_mps,ve_mps,vd_mps[,std_vn_mps,...] (gnss.csv too); a
     /// position log given here is an error.
     #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub gnss_vel: Option<PathBuf>,
-    /// Velocity standard deviation where the velocity log gives none (default 0.1 m/s).
+    /// Velocity standard deviation where the velocity log, or a position log's velocity
+    /// (NMEA speed and course, RTKLIB vn ve vu), gives none (default 0.1 m/s).
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
     pub gnss_vel_std: Option<String>,
     /// Antenna position in body axes, front, right, down [m].
@@ -278,6 +300,10 @@ impl AidingOptions {
         }
         pick!(
             gnss,
+            gnss_format,
+            gnss_std,
+            gnss_min_quality,
+            gnss_time_offset,
             gnss_vel,
             gnss_vel_std,
             lever_arm,
@@ -389,24 +415,56 @@ impl AidingOptions {
         }))
     }
 
-    /// The GNSS fixes, with the velocities of `--gnss-vel` merged in.
+    /// How `--gnss` is read, with `vel_std` [m/s] for velocities given without one.
+    fn gnss_read_options(&self, vel_std: f64) -> Result<GnssReadOptions> {
+        let default_std = match self.gnss_std {
+            Some(Triple(s)) if s.iter().all(|&x| x > 0.0) => Some(Vector3::from(s)),
+            Some(Triple(s)) => bail!("--gnss-std must be positive, got {s:?}"),
+            None => None,
+        };
+        Ok(GnssReadOptions {
+            format: self.gnss_format.unwrap_or_default(),
+            default_std,
+            min_quality: self.gnss_min_quality.unwrap_or_default(),
+            vel_std,
+        })
+    }
+
+    /// The GNSS fixes (the reader's warnings printed), with the velocities of
+    /// `--gnss-vel` merged in and `--gnss-time-offset` added to their times.
     fn fixes(&self) -> Result<Vec<GnssFix>> {
+        let vel_std =
+            quantity("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
+        if vel_std <= 0.0 {
+            bail!("--gnss-vel-std must be positive");
+        }
         let mut fixes = match &self.gnss {
-            Some(gnss) => crate::formats::gnss::read_gnss(gnss)?,
+            Some(gnss) => {
+                let log = read_gnss_log(gnss, &self.gnss_read_options(vel_std)?)?;
+                for w in &log.warnings {
+                    eprintln!("warning: {}: {w}", gnss.display());
+                }
+                log.fixes
+            }
             None => Vec::new(),
         };
         if let Some(v) = &self.gnss_vel {
-            let std =
-                quantity("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
-            if std <= 0.0 {
-                bail!("--gnss-vel-std must be positive");
-            }
-            let unmatched = crate::formats::gnss::merge_velocity(&mut fixes, v, std)?;
+            let unmatched = crate::formats::gnss::merge_velocity(&mut fixes, v, vel_std)?;
             if unmatched > 0 {
                 eprintln!(
                     "warning: {}: {unmatched} velocity epochs have no position fix at the same time and are not used",
                     v.display()
                 );
+            }
+        }
+        if let Some(text) = &self.gnss_time_offset {
+            let dt = parse_as_or_si(text.trim(), Dimension::Time)
+                .with_context(|| format!("--gnss-time-offset {text:?}"))?;
+            if !dt.is_finite() {
+                bail!("--gnss-time-offset must be finite, got {text:?}");
+            }
+            for f in &mut fixes {
+                f.t += dt;
             }
         }
         Ok(fixes)

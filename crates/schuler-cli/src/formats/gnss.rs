@@ -1,20 +1,28 @@
 //! GNSS and barometer logs: small files (one line per fix or reading), read whole.
-//! Blank lines and `#`/`%` comments are skipped everywhere, line numbers in errors count
-//! every line of the file (1-based), and every problem is an [`InputError`] naming the
-//! file, the line and the field.
+//! Fields are separated by spaces, tabs, commas or semicolons; blank lines and
+//! `#`/`%` comments are skipped everywhere; line numbers in errors count every line of
+//! the file (1-based), and every problem is an [`InputError`] naming the file, the
+//! line and the field.
 //!
-//! # Position logs ([`read_gnss`], `schuler nav --gnss`)
-//! The first data line tells the format: a header if its first field is not a number.
+//! # Position logs ([`read_gnss_log`], `schuler nav --gnss`)
+//! The format is told by the content ([`GnssFormat::Auto`]) or given
+//! (`--gnss-format`): NMEA 0183 sentences (`$GPGGA,...`, see [`super::nmea`]), an
+//! RTKLIB solution file whose `%` header names its columns (`.pos`, see
+//! [`super::rtklib`]), else text, whose first data line tells the layout: a header if
+//! its first field is not a number.
 //! - **KF-GINS text**: `t lat lon h std_n std_e std_d` [s, deg, deg, m, m, m, m], 7
-//!   columns, or 13 with `vn ve vd std_vn std_ve std_vd` [m/s] after them; blanks or
-//!   commas between fields. The 13-column layout is a receiver's position *and*
-//!   velocity, and its velocities are used as velocity aiding.
-//! - **CSV with a header**, as `schuler simulate` writes `gnss.csv`: comma-separated,
-//!   every data line with as many fields as the header, columns found by name (ASCII
+//!   columns, or 13 with `vn ve vd std_vn std_ve std_vd` [m/s] after them, or 4
+//!   (`t lat lon h`) with the standard deviations of `--gnss-std`. The 13-column
+//!   layout is a receiver's position *and* velocity, and its velocities are used as
+//!   velocity aiding.
+//! - **CSV with a header**, as `schuler simulate` writes `gnss.csv`: fields separated
+//!   as the header's are (its first comma, semicolon or tab, else blanks), every data
+//!   line with as many fields as the header, columns found by name (ASCII
 //!   case-insensitive, blanks and double quotes around a name ignored) in any order.
-//!   Required: `t` (or `time`), `lat_deg`, `lon_deg`, `h_m`, `std_n_m`, `std_e_m`,
-//!   `std_d_m`; a missing one is an error naming it and the header's line. Other
-//!   columns are ignored and not parsed, with two named on purpose:
+//!   Required: `t` (or `time`), `lat_deg`, `lon_deg`, `h_m`; `std_n_m`, `std_e_m`,
+//!   `std_d_m` all three or none (then `--gnss-std`); a missing column is an error
+//!   naming it and the header's line. Other columns are ignored and not parsed, with
+//!   two named on purpose:
 //!   - `outlier` (0 or 1) is checked and kept in [`GnssRecord::outlier`] but never
 //!     drops a fix: it is the simulator's *truth* (1 where it injected a jump), not a
 //!     receiver's quality flag, and a navigator that dropped flagged fixes would be
@@ -27,6 +35,11 @@
 //!
 //!   So `gnss.csv` gives the same fixes as `gnss.txt` (the simulator writes the same
 //!   numbers in both), and the same navigation.
+//!
+//! A file that gives no standard deviations for a fix (4 columns, a CSV without them,
+//! NMEA without GST, RTKLIB without `sdn sde sdu`) takes those of `--gnss-std`
+//! ([`GnssReadOptions::default_std`]); without it, that is an error naming the file,
+//! the line and the flag.
 //!
 //! # Velocity logs ([`merge_velocity`], `schuler nav --gnss-vel`)
 //! - **Text**: `t vn ve vd [std_vn std_ve std_vd]` [s, m/s], 4 or 7 columns (as
@@ -41,21 +54,22 @@
 //!   position log's `lat_deg`, `lon_deg`, `h_m` instead);
 //! - 13 text columns are the position-and-velocity layout; a velocity log has 4 or 7.
 //!
-//! Seven text columns are also the shape of a 7-column position log (`t lat lon h std_n
-//! std_e std_d`), which no count or range can tell apart (latitudes and longitudes in
-//! degrees are plausible speeds in m/s), so there the values decide against the
-//! position fixes the velocities are matched to: a text row whose `vn ve vd` repeat
-//! the latitude and longitude [deg] of the fix at the same time within 0.001° and its
-//! height [m] within 100 m is a position row, and the file is refused at that line. A
-//! velocity would have to equal the vehicle's own coordinates to 1 mm/s in both
-//! horizontal axes; a position log is caught even from another receiver on the same
-//! vehicle (metres apart; 0.001° of latitude is 111 m). The rule applies to every text row
-//! matched to a fix, whatever its column count.
+//! Four and seven text columns are also the shapes of position logs (`t lat lon h
+//! [std_n std_e std_d]`), which no count or range can tell apart (latitudes and
+//! longitudes in degrees are plausible speeds in m/s), so there the values decide
+//! against the position fixes the velocities are matched to: a text row whose `vn ve
+//! vd` repeat the latitude and longitude [deg] of the fix at the same time within
+//! 0.001° and its height [m] within 100 m is a position row, and the file is refused at
+//! that line. A velocity would have to equal the vehicle's own coordinates to 1 mm/s in
+//! both horizontal axes; a position log is caught even from another receiver on the
+//! same vehicle (metres apart; 0.001° of latitude is 111 m). The rule applies to every
+//! text row matched to a fix, whatever its column count.
 //!
 //! # Barometer logs ([`read_baro`], `schuler nav --baro`)
 //! `baro.csv` as `schuler simulate` writes it (`t,h_m,outlier`) or headerless `t h`.
 
 use super::error::{InputError, InputErrorKind};
+use super::lines::{Delimiter, data_lines, fields};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
@@ -68,9 +82,9 @@ const POS_FIELDS: [&str; 13] = [
 const VEL_FIELDS: [&str; 7] = ["time", "vn", "ve", "vd", "std_vn", "std_ve", "std_vd"];
 
 /// The columns a position CSV must name (the time first).
-const CSV_POS: [&str; 7] = [
-    "t", "lat_deg", "lon_deg", "h_m", "std_n_m", "std_e_m", "std_d_m",
-];
+const CSV_POS: [&str; 4] = ["t", "lat_deg", "lon_deg", "h_m"];
+/// The position standard deviations a position CSV may name, all three or none.
+const CSV_POS_STD: [&str; 3] = ["std_n_m", "std_e_m", "std_d_m"];
 /// The columns a velocity CSV must name (the time first).
 const CSV_VEL: [&str; 4] = ["t", "vn_mps", "ve_mps", "vd_mps"];
 /// The velocity standard deviations a velocity CSV may name, all three or none.
@@ -91,15 +105,125 @@ type Rows = Vec<(u64, Vec<f64>)>;
 /// `outlier` column).
 type FlaggedRows = Vec<(u64, Vec<f64>, Option<bool>)>;
 
-/// The whole text of a small log (a leading UTF-8 byte-order mark dropped).
-fn read_text(path: &Path) -> Result<String, InputError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+/// The position log formats [`read_gnss_log`] reads (`--gnss-format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GnssFormat {
+    /// Told by the content: NMEA sentences, an RTKLIB `%` column header, else text.
+    #[default]
+    Auto,
+    /// KF-GINS text (4, 7 or 13 columns) or CSV with a header.
+    Text,
+    /// NMEA 0183 sentences: GGA, RMC, VTG, GST.
+    Nmea,
+    /// An RTKLIB solution file (`.pos`, rnx2rtkp or RTKPOST output).
+    Rtklib,
+}
+
+impl GnssFormat {
+    /// The name used in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            GnssFormat::Auto => "auto",
+            GnssFormat::Text => "text",
+            GnssFormat::Nmea => "nmea",
+            GnssFormat::Rtklib => "rtklib",
+        }
+    }
+}
+
+/// Solution quality levels, worst first (`--gnss-min-quality`): RTKLIB's `Q` and
+/// NMEA GGA's fix quality mapped onto one scale.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, clap::ValueEnum, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum GnssQuality {
+    /// Single point positioning (RTKLIB Q 5; GGA 1, 7 manual, 8 simulator).
+    #[default]
+    Single,
+    /// Differential code positioning (RTKLIB Q 3 SBAS, 4 DGPS; GGA 2 DGPS, 3 PPS).
+    Dgps,
+    /// Carrier phase with float ambiguities, or PPP (RTKLIB Q 2, 6; GGA 5).
+    Float,
+    /// Carrier phase with fixed ambiguities (RTKLIB Q 1; GGA 4).
+    Fix,
+}
+
+impl GnssQuality {
+    /// The name used in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            GnssQuality::Single => "single",
+            GnssQuality::Dgps => "dgps",
+            GnssQuality::Float => "float",
+            GnssQuality::Fix => "fix",
+        }
+    }
+}
+
+/// How [`read_gnss_log`] reads a position log.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GnssReadOptions {
+    /// The format, or [`GnssFormat::Auto`].
+    pub format: GnssFormat,
+    /// Position standard deviations north, east, down [m] for fixes the file gives
+    /// none (`--gnss-std`).
+    pub default_std: Option<Vector3<f64>>,
+    /// Fixes of a lower quality are dropped (RTKLIB and NMEA files).
+    pub min_quality: GnssQuality,
+    /// Horizontal velocity standard deviation [m/s] where a format gives velocity
+    /// without one (NMEA speed and course, RTKLIB without `sdvn sdve sdvu`).
+    pub vel_std: f64,
+}
+
+impl Default for GnssReadOptions {
+    fn default() -> Self {
+        Self {
+            format: GnssFormat::Auto,
+            default_std: None,
+            min_quality: GnssQuality::Single,
+            vel_std: 0.1,
+        }
+    }
+}
+
+/// A position log as read: the fixes and what the reader has to say about the file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GnssLog {
+    /// The fixes in time order.
+    pub fixes: Vec<GnssFix>,
+    /// The format read (never [`GnssFormat::Auto`]).
+    pub format: GnssFormat,
+    /// Warnings for the user (sentences skipped, fixes dropped, time assumptions).
+    pub warnings: Vec<String>,
+}
+
+/// The bytes of a small log.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, InputError> {
+    std::fs::read(path).map_err(|e| {
         InputError::new(
             InputErrorKind::Io,
             path,
             0,
             None,
             format!("cannot read: {e}"),
+        )
+    })
+}
+
+/// `bytes` as text (a leading UTF-8 byte-order mark dropped), or an error naming the
+/// line of the first byte that is not UTF-8.
+pub(crate) fn utf8_text(path: &Path, bytes: Vec<u8>) -> Result<String, InputError> {
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+        InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            line,
+            None,
+            "not UTF-8 text",
         )
     })?;
     Ok(match text.strip_prefix('\u{feff}') {
@@ -108,33 +232,19 @@ fn read_text(path: &Path) -> Result<String, InputError> {
     })
 }
 
-/// The lines that may carry data, trimmed, with their 1-based numbers: blank lines and
-/// `#`/`%` comments skipped.
-fn content_lines(text: &str) -> impl Iterator<Item = (u64, &str)> {
-    text.lines().enumerate().filter_map(|(i, line)| {
-        let l = line.trim();
-        let skip = l.is_empty() || l.starts_with('#') || l.starts_with('%');
-        (!skip).then_some((i as u64 + 1, l))
-    })
-}
-
-/// The fields of a text line: separated by blanks or commas.
-fn text_fields(l: &str) -> Vec<&str> {
-    l.split(|c: char| c.is_whitespace() || c == ',')
-        .filter(|f| !f.is_empty())
-        .collect()
+/// The whole text of a small log (a leading UTF-8 byte-order mark dropped).
+fn read_text(path: &Path) -> Result<String, InputError> {
+    utf8_text(path, read_bytes(path)?)
 }
 
 /// Whether the first data line is a CSV header: its first field is not a number.
 fn is_header(l: &str) -> bool {
-    text_fields(l)
-        .first()
-        .is_some_and(|f| f.parse::<f64>().is_err())
+    fields(l).next().is_some_and(|f| f.parse::<f64>().is_err())
 }
 
 /// Field `name` of line `n` parsed from `text`: a finite number, and positive if `name`
 /// is a standard deviation (starts with `std`; `std_hint` is then added to the error).
-fn parse_field(
+pub(crate) fn parse_field(
     path: &Path,
     n: u64,
     name: &str,
@@ -171,29 +281,78 @@ fn parse_field(
     Ok(x)
 }
 
-/// Checks that time `t` of line `n` (field `name`) comes after the previous row's.
-fn check_time(
+/// Checks that time `t` of line `n` (field `name`) comes after `prev`, the previous
+/// row's time.
+pub(crate) fn check_time(
     path: &Path,
     n: u64,
     name: &str,
     t: f64,
-    prev: Option<&(u64, Vec<f64>)>,
+    prev: Option<f64>,
 ) -> Result<(), InputError> {
     match prev {
-        Some((_, p)) if t <= p[0] => Err(InputError::new(
+        Some(p) if t <= p => Err(InputError::new(
             InputErrorKind::TimeNotIncreasing,
             path,
             n,
             Some(name),
-            format!("time {t} does not increase (previous {})", p[0]),
+            format!("time {t} does not increase (previous {p})"),
         )),
         _ => Ok(()),
     }
 }
 
 /// The error of a file without a data line.
-fn no_data(path: &Path) -> InputError {
+pub(crate) fn no_data(path: &Path) -> InputError {
     InputError::new(InputErrorKind::NoData, path, 0, None, "no data line")
+}
+
+/// A warning `N what` for each count `(N, what)` that is not 0.
+pub(crate) fn count_warnings(counts: &[(usize, String)]) -> Vec<String> {
+    counts
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}"))
+        .collect()
+}
+
+/// What the warning of the fixes dropped by `--gnss-min-quality` says after its count.
+pub(crate) fn below_quality(min: GnssQuality) -> String {
+    format!("fixes below --gnss-min-quality {} dropped", min.name())
+}
+
+/// The error of a log without a fix to use, with the `warnings` that say why.
+pub(crate) fn no_usable_fix(path: &Path, warnings: &[String]) -> InputError {
+    if warnings.is_empty() {
+        return no_data(path);
+    }
+    InputError::new(
+        InputErrorKind::NoData,
+        path,
+        0,
+        None,
+        format!("no usable fix ({})", warnings.join("; ")),
+    )
+}
+
+/// The standard deviations of a fix at line `n` that gives none: `default` (the
+/// `--gnss-std` flag), or an error naming the file, the line, `field` and the flag.
+pub(crate) fn default_std(
+    path: &Path,
+    n: u64,
+    field: &str,
+    default: Option<Vector3<f64>>,
+) -> Result<Vector3<f64>, InputError> {
+    default.ok_or_else(|| {
+        InputError::new(
+            InputErrorKind::Usage,
+            path,
+            n,
+            Some(field),
+            "the file gives no position standard deviations for this fix: give them with \
+             --gnss-std N,E,D [m]",
+        )
+    })
 }
 
 /// Numbers of each data line (blank lines and `#`/`%` comments skipped, and with
@@ -208,7 +367,7 @@ pub(crate) fn numeric_rows(
     header: bool,
 ) -> Result<Rows, InputError> {
     let text = read_text(path)?;
-    let lines = content_lines(&text)
+    let lines = data_lines(&text)
         .filter(|&(n, l)| !(header && n == 1 && l.starts_with(|c: char| c.is_ascii_alphabetic())));
     text_rows(path, lines, names, counts, &|k| {
         format!("{k} columns, expected {counts:?}")
@@ -226,7 +385,7 @@ fn text_rows<'a>(
 ) -> Result<Rows, InputError> {
     let mut rows: Rows = Vec::new();
     for (n, l) in lines {
-        let fields = text_fields(l);
+        let fields: Vec<&str> = fields(l).collect();
         if !counts.contains(&fields.len()) {
             return Err(InputError::new(
                 InputErrorKind::ColumnCount,
@@ -241,7 +400,7 @@ fn text_rows<'a>(
             .zip(names)
             .map(|(f, name)| parse_field(path, n, name, f, ""))
             .collect::<Result<Vec<f64>, _>>()?;
-        check_time(path, n, names[0], v[0], rows.last())?;
+        check_time(path, n, names[0], v[0], rows.last().map(|r| r.1[0]))?;
         rows.push((n, v));
     }
     if rows.is_empty() {
@@ -251,21 +410,23 @@ fn text_rows<'a>(
 }
 
 /// A CSV log's header line: the column names as written, each trimmed of blanks and
-/// double quotes.
+/// double quotes, and how its fields are separated.
 struct CsvHeader<'a> {
     path: &'a Path,
     /// 1-based line number of the header.
     line: u64,
     names: Vec<String>,
+    delimiter: Delimiter,
 }
 
 impl<'a> CsvHeader<'a> {
     /// The header in line `line` (text `l`) of `path`.
     fn parse(path: &'a Path, line: u64, l: &str) -> Self {
-        let names = l
-            .split(',')
-            .map(|raw| {
-                let name = raw.trim();
+        let delimiter = Delimiter::of_header(l);
+        let names = delimiter
+            .split(l)
+            .into_iter()
+            .map(|name| {
                 let name = name
                     .strip_prefix('"')
                     .and_then(|s| s.strip_suffix('"'))
@@ -273,7 +434,12 @@ impl<'a> CsvHeader<'a> {
                 name.trim().to_owned()
             })
             .collect();
-        Self { path, line, names }
+        Self {
+            path,
+            line,
+            names,
+            delimiter,
+        }
     }
 
     /// A header error with `message`.
@@ -316,10 +482,11 @@ impl<'a> CsvHeader<'a> {
         if missing.is_empty() {
             return Ok(cols);
         }
-        let taken = if missing.len() == names.len() {
+        // None found but perhaps the time: the line may not be meant as a header.
+        let taken = if missing.len() + 1 >= names.len() {
             format!(
                 "; line {} was taken for a CSV header because its first field is not a \
-                 number (a header names comma-separated columns)",
+                 number (a header names the columns)",
                 self.line
             )
         } else {
@@ -336,9 +503,42 @@ impl<'a> CsvHeader<'a> {
         ))
     }
 
-    /// Rows of numbers after the header: each line comma-separated with as many fields
-    /// as the header names, the columns `cols` (index, name for errors) parsed in their
-    /// order (checked as [`parse_field`] does, `std_hint` added to a standard deviation's
+    /// The columns of `names` (index, name), all of them or none (an error naming the
+    /// missing ones when the header names only some); `what` says what they are.
+    fn all_or_none<'n>(
+        &self,
+        names: &[&'n str],
+        what: &str,
+    ) -> Result<Vec<(usize, &'n str)>, InputError> {
+        let mut found = Vec::new();
+        let mut missing = Vec::new();
+        for &name in names {
+            match self.find(name)? {
+                Some(c) => found.push((c, name)),
+                None => missing.push(name),
+            }
+        }
+        if !found.is_empty() && !missing.is_empty() {
+            return Err(self.error(
+                Some(missing[0]),
+                format!(
+                    "the header names {} but not {}: {what} gives its standard deviations \
+                     all three or none",
+                    found
+                        .iter()
+                        .map(|(_, name)| *name)
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    missing.join(", ")
+                ),
+            ));
+        }
+        Ok(found)
+    }
+
+    /// Rows of numbers after the header: each line with as many fields as the header
+    /// names, the columns `cols` (index, name for errors) parsed in their order
+    /// (checked as [`parse_field`] does, `std_hint` added to a standard deviation's
     /// error), the first one the time, which must increase.
     fn rows<'l>(
         &self,
@@ -348,7 +548,7 @@ impl<'a> CsvHeader<'a> {
     ) -> Result<Rows, InputError> {
         let mut rows: Rows = Vec::new();
         for (n, l) in lines {
-            let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+            let fields = self.delimiter.split(l);
             if fields.len() != self.names.len() {
                 return Err(InputError::new(
                     InputErrorKind::ColumnCount,
@@ -367,7 +567,7 @@ impl<'a> CsvHeader<'a> {
                 .iter()
                 .map(|&(c, name)| parse_field(self.path, n, name, fields[c], std_hint))
                 .collect::<Result<Vec<f64>, _>>()?;
-            check_time(self.path, n, cols[0].1, v[0], rows.last())?;
+            check_time(self.path, n, cols[0].1, v[0], rows.last().map(|r| r.1[0]))?;
             rows.push((n, v));
         }
         if rows.is_empty() {
@@ -406,7 +606,8 @@ fn outlier_flag(path: &Path, n: u64, x: Option<f64>) -> Result<Option<bool>, Inp
 }
 
 /// Rows of a position CSV after its header `h`: the required columns in
-/// [`CSV_POS`] order, and the outlier flag where the header names it.
+/// [`CSV_POS`] order, the standard deviations where the header names them, and the
+/// outlier flag where it names it.
 fn csv_position_rows<'l>(
     path: &Path,
     h: &CsvHeader,
@@ -417,6 +618,7 @@ fn csv_position_rows<'l>(
         .into_iter()
         .zip(CSV_POS)
         .collect();
+    cols.extend(h.all_or_none(&CSV_POS_STD, "a position log")?);
     let outlier = h.find(CSV_OUTLIER)?;
     if let Some(c) = outlier {
         cols.push((c, CSV_OUTLIER));
@@ -429,14 +631,16 @@ fn csv_position_rows<'l>(
     Ok(out)
 }
 
-/// The record of line `n`'s values `v` (`t lat lon h std_n std_e std_d [vn ve vd
-/// std_vn std_ve std_vd]`) after checking the latitude (named `lat_name` in the error).
+/// The record of line `n`'s values `v` (`t lat lon h [std_n std_e std_d [vn ve vd
+/// std_vn std_ve std_vd]]`) after checking the latitude (named `lat_name` in the
+/// error); `default_std` where `v` gives no standard deviations.
 fn gnss_record(
     path: &Path,
     n: u64,
     v: &[f64],
     outlier: Option<bool>,
-    lat_name: &str,
+    (lat_name, std_name): (&str, &str),
+    std: Option<Vector3<f64>>,
 ) -> Result<GnssRecord, InputError> {
     if !(-90.0..=90.0).contains(&v[1]) {
         return Err(InputError::new(
@@ -447,10 +651,14 @@ fn gnss_record(
             format!("latitude {} is outside [-90, 90]", v[1]),
         ));
     }
+    let pos_std = match v.get(4..7) {
+        Some(s) => Vector3::new(s[0], s[1], s[2]),
+        None => default_std(path, n, std_name, std)?,
+    };
     let fix = GnssFix {
         t: v[0],
         pos: Geodetic::from_degrees(v[1], v[2], v[3]),
-        pos_std: Vector3::new(v[4], v[5], v[6]),
+        pos_std,
         vel: (v.len() == 13).then(|| {
             (
                 Vector3::new(v[7], v[8], v[9]),
@@ -465,11 +673,15 @@ fn gnss_record(
     })
 }
 
-/// Read a GNSS position log (KF-GINS text, 7 or 13 columns, or CSV with a header; see
-/// the module doc) with each fix's line and outlier flag.
-pub fn read_gnss_records(path: &Path) -> Result<Vec<GnssRecord>, InputError> {
+/// Read a GNSS position log of text (KF-GINS text, 4, 7 or 13 columns, or CSV with a
+/// header; see the module doc) with each fix's line and outlier flag; `default_std`
+/// [m] for fixes the file gives no standard deviations.
+pub fn read_text_records(
+    path: &Path,
+    default_std: Option<Vector3<f64>>,
+) -> Result<Vec<GnssRecord>, InputError> {
     let text = read_text(path)?;
-    let mut lines = content_lines(&text).peekable();
+    let mut lines = data_lines(&text).peekable();
     let header = match lines.peek() {
         Some(&(n, l)) if is_header(l) => {
             lines.next();
@@ -477,30 +689,37 @@ pub fn read_gnss_records(path: &Path) -> Result<Vec<GnssRecord>, InputError> {
         }
         _ => None,
     };
-    // Rows as `t lat lon h std_n std_e std_d [vn ve vd std_vn std_ve std_vd]`, and the
-    // outlier flag.
-    let (rows, lat_name) = match &header {
+    // Rows as `t lat lon h [std_n std_e std_d [vn ve vd std_vn std_ve std_vd]]`, and
+    // the outlier flag.
+    let (rows, names) = match &header {
         None => {
-            let rows = text_rows(path, lines, &POS_FIELDS, &[7, 13], &|k| {
-                format!("{k} columns, expected [7, 13]")
+            let rows = text_rows(path, lines, &POS_FIELDS, &[4, 7, 13], &|k| {
+                format!("{k} columns, expected [4, 7, 13]")
             })?;
             (
                 rows.into_iter()
                     .map(|(n, v)| (n, v, None))
                     .collect::<Vec<_>>(),
-                "lat",
+                ("lat", "std_n"),
             )
         }
-        Some(h) => (csv_position_rows(path, h, lines)?, "lat_deg"),
+        Some(h) => (csv_position_rows(path, h, lines)?, ("lat_deg", "std_n_m")),
     };
     rows.into_iter()
-        .map(|(n, v, outlier)| gnss_record(path, n, &v, outlier, lat_name))
+        .map(|(n, v, outlier)| gnss_record(path, n, &v, outlier, names, default_std))
         .collect()
 }
 
-/// Read a GNSS position log (KF-GINS text, 7 or 13 columns, or CSV with a header; see
-/// the module doc): the fixes in time order, with velocity where the 13-column layout
-/// gives it.
+/// Read a GNSS position log of text (KF-GINS text or CSV with a header, see the
+/// module doc) that gives its standard deviations, with each fix's line and outlier
+/// flag.
+pub fn read_gnss_records(path: &Path) -> Result<Vec<GnssRecord>, InputError> {
+    read_text_records(path, None)
+}
+
+/// Read a GNSS position log of text that gives its standard deviations (KF-GINS text,
+/// 7 or 13 columns, or CSV with a header; see the module doc): the fixes in time
+/// order, with velocity where the 13-column layout gives it.
 pub fn read_gnss(path: &Path) -> Result<Vec<GnssFix>, InputError> {
     Ok(read_gnss_records(path)?
         .into_iter()
@@ -508,11 +727,72 @@ pub fn read_gnss(path: &Path) -> Result<Vec<GnssFix>, InputError> {
         .collect())
 }
 
+/// Whether `line` (trimmed) is an NMEA 0183 sentence: `$`, a talker and sentence
+/// type of five upper-case letters or digits, a comma.
+pub(crate) fn is_nmea_sentence(line: &[u8]) -> bool {
+    line.len() > 7
+        && line[0] == b'$'
+        && line[1..6]
+            .iter()
+            .all(|b| b.is_ascii_uppercase() || b.is_ascii_digit())
+        && line[6] == b','
+}
+
+/// The format of a position log by its content: NMEA if one of its first 200 lines
+/// is a sentence, RTKLIB if a `%` line before its first data line names RTKLIB's
+/// position columns, else text.
+fn detect(bytes: &[u8]) -> GnssFormat {
+    let lines = || {
+        bytes
+            .split(|&b| b == b'\n')
+            .take(200)
+            .map(<[u8]>::trim_ascii)
+    };
+    if lines().any(is_nmea_sentence) {
+        return GnssFormat::Nmea;
+    }
+    for l in lines() {
+        if l.is_empty() || l.starts_with(b"#") {
+            continue;
+        }
+        if !l.starts_with(b"%") {
+            break;
+        }
+        if super::rtklib::is_column_header(&String::from_utf8_lossy(l)) {
+            return GnssFormat::Rtklib;
+        }
+    }
+    GnssFormat::Text
+}
+
+/// Read a GNSS position log of any format (the module doc; `opts.format`, or told by
+/// the content): the fixes in time order, with velocity where the format gives it,
+/// and the reader's warnings.
+pub fn read_gnss_log(path: &Path, opts: &GnssReadOptions) -> Result<GnssLog, InputError> {
+    let bytes = read_bytes(path)?;
+    let format = match opts.format {
+        GnssFormat::Auto => detect(&bytes),
+        f => f,
+    };
+    match format {
+        GnssFormat::Nmea => super::nmea::read_nmea(path, &bytes, opts),
+        GnssFormat::Rtklib => super::rtklib::read_rtklib(path, &utf8_text(path, bytes)?, opts),
+        GnssFormat::Auto | GnssFormat::Text => Ok(GnssLog {
+            fixes: read_text_records(path, opts.default_std)?
+                .into_iter()
+                .map(|r| r.fix)
+                .collect(),
+            format: GnssFormat::Text,
+            warnings: Vec::new(),
+        }),
+    }
+}
+
 /// A velocity log's rows as `t vn ve vd [std_vn std_ve std_vd]`, and whether the file
 /// is headerless text (whose rows [`merge_velocity`] checks against the fixes).
 fn read_velocity(path: &Path) -> Result<(Rows, bool), InputError> {
     let text = read_text(path)?;
-    let mut lines = content_lines(&text).peekable();
+    let mut lines = data_lines(&text).peekable();
     let header = match lines.peek() {
         Some(&(n, l)) if is_header(l) => {
             lines.next();
@@ -549,30 +829,7 @@ fn read_velocity(path: &Path) -> Result<(Rows, bool), InputError> {
         .into_iter()
         .zip(CSV_VEL)
         .collect();
-    let mut std_cols = Vec::new();
-    let mut std_missing = Vec::new();
-    for name in CSV_VEL_STD {
-        match header.find(name)? {
-            Some(c) => std_cols.push((c, name)),
-            None => std_missing.push(name),
-        }
-    }
-    if !std_cols.is_empty() && !std_missing.is_empty() {
-        return Err(header.error(
-            Some(std_missing[0]),
-            format!(
-                "the header names {} but not {}: a velocity log gives its standard \
-                 deviations all three or none",
-                std_cols
-                    .iter()
-                    .map(|(_, name)| *name)
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                std_missing.join(", ")
-            ),
-        ));
-    }
-    cols.extend(std_cols);
+    cols.extend(header.all_or_none(&CSV_VEL_STD, "a velocity log")?);
     let rows = header.rows(
         lines,
         &cols,
@@ -651,30 +908,15 @@ fn check_not_position(path: &Path, n: u64, v: &[f64], fix: &GnssFix) -> Result<(
 /// `t,h_m[,outlier]`; the outlier flag, the simulator's truth, is not read) or headerless
 /// `t h` rows. Returns `(t, h)` pairs in time order.
 pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        InputError::new(
-            InputErrorKind::Io,
-            path,
-            0,
-            None,
-            format!("cannot read: {e}"),
-        )
-    })?;
+    let text = read_text(path)?;
+    let mut lines = data_lines(&text).peekable();
+    if lines.peek().is_some_and(|&(_, l)| is_header(l)) {
+        lines.next();
+    }
     let mut out: Vec<(f64, f64)> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let n = i as u64 + 1;
-        let l = line.trim();
-        if l.is_empty()
-            || l.starts_with('#')
-            || (n == 1 && l.starts_with(|c: char| c.is_ascii_alphabetic()))
-        {
-            continue;
-        }
-        let fields: Vec<&str> = l
-            .split(|c: char| c.is_whitespace() || c == ',')
-            .filter(|f| !f.is_empty())
-            .collect();
-        if fields.len() < 2 {
+    for (n, l) in lines {
+        let f: Vec<&str> = fields(l).collect();
+        if f.len() < 2 {
             return Err(InputError::new(
                 InputErrorKind::ColumnCount,
                 path,
@@ -683,43 +925,13 @@ pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
                 "expected t and h",
             ));
         }
-        let mut v = [0.0; 2];
-        for (k, name) in ["time", "h"].iter().enumerate() {
-            v[k] = fields[k]
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| {
-                    InputError::new(
-                        InputErrorKind::NotANumber,
-                        path,
-                        n,
-                        Some(name),
-                        format!("not a finite number: {:?}", fields[k]),
-                    )
-                })?;
-        }
-        if let Some(&(t, _)) = out.last()
-            && v[0] <= t
-        {
-            return Err(InputError::new(
-                InputErrorKind::TimeNotIncreasing,
-                path,
-                n,
-                Some("time"),
-                format!("time {} does not increase (previous {t})", v[0]),
-            ));
-        }
-        out.push((v[0], v[1]));
+        let t = parse_field(path, n, "time", f[0], "")?;
+        let h = parse_field(path, n, "h", f[1], "")?;
+        check_time(path, n, "time", t, out.last().map(|p| p.0))?;
+        out.push((t, h));
     }
     if out.is_empty() {
-        return Err(InputError::new(
-            InputErrorKind::NoData,
-            path,
-            0,
-            None,
-            "no data line",
-        ));
+        return Err(no_data(path));
     }
     Ok(out)
 }
@@ -787,7 +999,7 @@ mod tests {
             (
                 "t,lat_deg,lon_deg,std_n_m,std_e_m,std_d_m\n1,45,7,1,1,1\n",
                 ":1: field h_m: the header lacks column h_m (a GNSS position log needs t, \
-                 lat_deg, lon_deg, h_m, std_n_m, std_e_m, std_d_m",
+                 lat_deg, lon_deg, h_m; other columns are ignored)",
             ),
             (
                 "# c\nt,lat,lon,h_m,std_n_m,std_e_m,std_d_m\n",
@@ -947,6 +1159,70 @@ mod tests {
         let f = file("t,h_m,outlier\n0.1,abc,0\n");
         let e = read_baro(f.path()).expect_err("bad").to_string();
         assert!(e.contains(":2: field h"), "{e}");
+    }
+
+    #[test]
+    fn four_columns_take_the_default_std_and_any_separator_works() {
+        let std = Some(Vector3::new(0.5, 0.6, 1.5));
+        let four = file("# t lat lon h\n1\t45.5;7.25, 100\n\n2 45.5 7.25 101\n");
+        let records = read_text_records(four.path(), std).expect("reads");
+        assert_eq!(records.len(), 2);
+        assert_eq!(
+            records[0].fix.pos,
+            Geodetic::from_degrees(45.5, 7.25, 100.0)
+        );
+        assert_eq!(records[1].fix.pos_std, Vector3::new(0.5, 0.6, 1.5));
+        assert_eq!(records[1].line, 4);
+        let e = read_gnss(four.path()).expect_err("no std").to_string();
+        assert!(
+            e.ends_with(
+                ":2: field std_n: the file gives no position standard deviations for \
+                         this fix: give them with --gnss-std N,E,D [m]"
+            ),
+            "{e}"
+        );
+        // A CSV with semicolons and no standard deviations; one with only some of them.
+        let csv = file("t;lat_deg;lon_deg;h_m\n1;45.5;7.25;100\n");
+        let r = read_text_records(csv.path(), std).expect("reads");
+        assert_eq!(r[0].fix, records[0].fix);
+        let e = read_gnss(csv.path()).expect_err("no std").to_string();
+        assert!(e.contains(":2: field std_n_m: the file gives no"), "{e}");
+        let csv = file("t;lat_deg;lon_deg;h_m;std_e_m\n1;45.5;7.25;100;1\n");
+        let e = read_text_records(csv.path(), std)
+            .expect_err("some")
+            .to_string();
+        assert!(
+            e.contains(":1: field std_n_m: the header names std_e_m but not std_n_m, std_d_m"),
+            "{e}"
+        );
+        // The baro log with tabs and a comment before its header.
+        let baro = file("# sensor\nt\th_m\n0.1\t100.5\n");
+        assert_eq!(read_baro(baro.path()).expect("reads"), vec![(0.1, 100.5)]);
+    }
+
+    #[test]
+    fn the_format_is_told_by_the_content() {
+        let opts = GnssReadOptions {
+            default_std: Some(Vector3::repeat(1.0)),
+            ..GnssReadOptions::default()
+        };
+        let cases = [
+            ("1 45 7 100\n", GnssFormat::Text),
+            ("% matlab comment\n1 45 7 100\n", GnssFormat::Text),
+            (
+                "% (lat/lon/height=WGS84/ellipsoidal)\n%  GPST latitude(deg) longitude(deg) \
+                 height(m)\n2000 1.0 45 7 100\n",
+                GnssFormat::Rtklib,
+            ),
+            (
+                "\u{1}\u{2}binary\n$GPGGA,000001,4504.2,N,00740.8,E,1,8,1.0,200.0,M,0.0,M,,*44\n",
+                GnssFormat::Nmea,
+            ),
+        ];
+        for (text, want) in cases {
+            let log = read_gnss_log(file(text).path(), &opts).expect(text);
+            assert_eq!((log.format, log.fixes.len()), (want, 1), "{text:?}");
+        }
     }
 
     #[test]

@@ -112,6 +112,55 @@ pub(crate) fn is_skippable(line: &[u8]) -> bool {
     }
 }
 
+/// Whether a field separator of the text formats: space, tab, comma or semicolon.
+#[inline]
+pub(crate) fn is_separator(c: char) -> bool {
+    matches!(c, ' ' | '\t' | ',' | ';')
+}
+
+/// The fields of a headerless text line: separated by runs of spaces, tabs, commas or
+/// semicolons (so an empty field between two commas is no field).
+pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
+    line.split(is_separator).filter(|f| !f.is_empty())
+}
+
+/// The lines of a whole text that may carry data, trimmed, with their 1-based numbers:
+/// blank lines and comments ([`is_skippable`]) left out.
+pub(crate) fn data_lines(text: &str) -> impl Iterator<Item = (u64, &str)> {
+    text.lines().enumerate().filter_map(|(i, line)| {
+        let l = line.trim();
+        (!is_skippable(l.as_bytes())).then_some((i as u64 + 1, l))
+    })
+}
+
+/// How the fields of a file with a header row are separated, told by the header: the
+/// first of comma, semicolon and tab it holds, else runs of blanks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Delimiter {
+    /// One character between two fields (an empty field is a field).
+    Char(char),
+    /// Runs of spaces and tabs.
+    Blanks,
+}
+
+impl Delimiter {
+    /// The delimiter of header line `header`.
+    pub(crate) fn of_header(header: &str) -> Self {
+        [',', ';', '\t']
+            .into_iter()
+            .find(|&c| header.contains(c))
+            .map_or(Delimiter::Blanks, Delimiter::Char)
+    }
+
+    /// The fields of `line`, each trimmed of blanks.
+    pub(crate) fn split(self, line: &str) -> Vec<&str> {
+        match self {
+            Delimiter::Char(c) => line.split(c).map(str::trim).collect(),
+            Delimiter::Blanks => line.split_whitespace().collect(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -149,5 +198,19 @@ mod tests {
         assert!(is_skippable(b"# comment"));
         assert!(is_skippable(b"  % matlab comment"));
         assert!(!is_skippable(b" 1 2 3"));
+    }
+
+    #[test]
+    fn separators_comments_and_delimiters() {
+        let f: Vec<&str> = fields("1\t2, 3;4  ;5,,6").collect();
+        assert_eq!(f, ["1", "2", "3", "4", "5", "6"]);
+        let lines: Vec<(u64, &str)> = data_lines("# c\n\n 1 2 \n% m\n3\n").collect();
+        assert_eq!(lines, [(3, "1 2"), (5, "3")]);
+        assert_eq!(Delimiter::of_header("t;h_m"), Delimiter::Char(';'));
+        assert_eq!(Delimiter::of_header("t,h_m;x"), Delimiter::Char(','));
+        assert_eq!(Delimiter::of_header("t\th_m"), Delimiter::Char('\t'));
+        assert_eq!(Delimiter::of_header("t h_m"), Delimiter::Blanks);
+        assert_eq!(Delimiter::Char(';').split(" 1; ;3"), ["1", "", "3"]);
+        assert_eq!(Delimiter::Blanks.split(" 1  2\t3"), ["1", "2", "3"]);
     }
 }

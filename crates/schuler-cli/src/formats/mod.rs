@@ -7,9 +7,12 @@
 
 pub mod error;
 pub mod gnss;
+mod gps_time;
 pub mod imu_log;
 mod lines;
 pub mod nav;
+pub mod nmea;
+pub mod rtklib;
 pub mod sensor_errors;
 pub mod vehicle;
 

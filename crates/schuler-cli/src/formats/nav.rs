@@ -6,22 +6,22 @@
 //! `KF_GINS_Navresult.nav` and the data sets' `truth.nav`) or schuler's `nav.csv` (a
 //! header naming at least `t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,
 //! pitch_deg,yaw_deg`, in any order, other columns ignored). The format is told by the
-//! first data line: a header starts with a letter. Blank lines and `#`/`%` comments are
-//! skipped. The time is the second of week; in a KF-GINS file a later week continues
+//! first data line: a header starts with a letter. Fields are separated by spaces,
+//! tabs, commas or semicolons (a CSV's as its header's are); blank lines and `#`/`%`
+//! comments are skipped. The time is the second of week; in a KF-GINS file a later week continues
 //! it (`sow + 604800 (week - first week)`), so a rollover inside a file is no step, but
 //! the weeks of two files are not compared (schuler writes week 0 where it knows none).
 //! A file is read whole (80 bytes per epoch).
 
 use super::error::{InputError, InputErrorKind, quote_field};
+use super::gps_time::WeekClock;
+use super::lines::{Delimiter, fields, is_skippable};
 use nalgebra::Vector3;
 use schuler::analysis::errors::NavRecord;
 use schuler::earth::Geodetic;
 use schuler::rotation::Euler;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-
-/// Seconds in a GPS week.
-const WEEK_S: f64 = 604_800.0;
 
 /// The layouts [`read_nav`] tells apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,18 +98,15 @@ fn number(path: &Path, n: u64, field: &str, text: &str) -> Result<f64, InputErro
 }
 
 /// The values of KF-GINS line `n` (time, lat, lon [deg], h, vn, ve, vd, roll, pitch,
-/// yaw [deg]): 11 columns, a whole week >= 0, the time of week continued from the
-/// file's `first_week` (set by its first line).
+/// yaw [deg]): 11 columns, a whole week >= 0, the time of week continued by `clock`
+/// from the file's first week.
 fn kf_gins_values(
     path: &Path,
     n: u64,
     l: &str,
-    first_week: &mut Option<f64>,
+    clock: &mut WeekClock,
 ) -> Result<[f64; 10], InputError> {
-    let fields: Vec<&str> = l
-        .split(|c: char| c.is_whitespace() || c == ',')
-        .filter(|f| !f.is_empty())
-        .collect();
+    let fields: Vec<&str> = fields(l).collect();
     if fields.len() != KF_GINS_FIELDS.len() {
         return Err(InputError::new(
             InputErrorKind::ColumnCount,
@@ -136,33 +133,31 @@ fn kf_gins_values(
             format!("a GPS week is a whole number >= 0, got {}", fields[0]),
         ));
     }
-    let week0 = *first_week.get_or_insert(week);
     let mut v = [0.0; 10];
-    v[0] = x[1] + (week - week0) * WEEK_S;
+    v[0] = clock.seconds(week as i64, x[1]);
     v[1..].copy_from_slice(&x[2..]);
     Ok(v)
 }
 
+/// Where a CSV header's columns are: its delimiter, its column count and the index of
+/// each of [`CSV_FIELDS`].
+type CsvColumns = (Delimiter, usize, [usize; 10]);
+
 /// The values of CSV line `n` in [`CSV_FIELDS`] order, from a line with as many
-/// fields as the header names (`columns`: that count and where each of them is).
-fn csv_values(
-    path: &Path,
-    n: u64,
-    l: &str,
-    columns: &(usize, [usize; 10]),
-) -> Result<[f64; 10], InputError> {
-    let fields: Vec<&str> = l.split(',').map(str::trim).collect();
-    if fields.len() != columns.0 {
+/// fields as the header names (`columns`).
+fn csv_values(path: &Path, n: u64, l: &str, columns: &CsvColumns) -> Result<[f64; 10], InputError> {
+    let fields = columns.0.split(l);
+    if fields.len() != columns.1 {
         return Err(InputError::new(
             InputErrorKind::ColumnCount,
             path,
             n,
             None,
-            format!("{} columns, the header names {}", fields.len(), columns.0),
+            format!("{} columns, the header names {}", fields.len(), columns.1),
         ));
     }
     let mut v = [0.0; 10];
-    for (k, &i) in columns.1.iter().enumerate() {
+    for (k, &i) in columns.2.iter().enumerate() {
         v[k] = number(path, n, CSV_FIELDS[k], fields[i])?;
     }
     Ok(v)
@@ -211,9 +206,8 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
     let mut buf: Vec<u8> = Vec::new();
     let mut n: u64 = 0;
     let mut format = None;
-    // For CSV: the column count and the index of each of CSV_FIELDS.
-    let mut csv_columns = (0usize, [0usize; 10]);
-    let mut first_week = None;
+    let mut csv_columns: CsvColumns = (Delimiter::Blanks, 0, [0; 10]);
+    let mut clock = WeekClock::default();
     let mut rows: Vec<NavRecord> = Vec::new();
     loop {
         buf.clear();
@@ -230,7 +224,7 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
                 InputError::new(InputErrorKind::NotANumber, path, n, None, "not UTF-8 text")
             })?
             .trim();
-        if l.is_empty() || l.starts_with('#') || l.starts_with('%') {
+        if is_skippable(l.as_bytes()) {
             continue;
         }
         let fmt = match format {
@@ -243,10 +237,7 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
             None => *format.insert(NavFormat::KfGins),
         };
         let (v, names) = match fmt {
-            NavFormat::KfGins => (
-                kf_gins_values(path, n, l, &mut first_week)?,
-                &KF_GINS_VALUES,
-            ),
+            NavFormat::KfGins => (kf_gins_values(path, n, l, &mut clock)?, &KF_GINS_VALUES),
             NavFormat::Csv => (csv_values(path, n, l, &csv_columns)?, &CSV_FIELDS),
         };
         let r = record(path, n, v, names, rows.last())?;
@@ -264,9 +255,14 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
     }
 }
 
-/// The column count of a CSV header and where each of [`CSV_FIELDS`] is.
-fn csv_header(path: &Path, n: u64, l: &str) -> Result<(usize, [usize; 10]), InputError> {
-    let names: Vec<&str> = l.split(',').map(|s| s.trim().trim_matches('"')).collect();
+/// The delimiter and column count of a CSV header and where each of [`CSV_FIELDS`] is.
+fn csv_header(path: &Path, n: u64, l: &str) -> Result<CsvColumns, InputError> {
+    let delimiter = Delimiter::of_header(l);
+    let names: Vec<&str> = delimiter
+        .split(l)
+        .into_iter()
+        .map(|s| s.trim_matches('"').trim())
+        .collect();
     let mut index = [0usize; 10];
     for (k, want) in CSV_FIELDS.iter().enumerate() {
         index[k] = names.iter().position(|h| h == want).ok_or_else(|| {
@@ -282,7 +278,7 @@ fn csv_header(path: &Path, n: u64, l: &str) -> Result<(usize, [usize; 10]), Inpu
             )
         })?;
     }
-    Ok((names.len(), index))
+    Ok((delimiter, names.len(), index))
 }
 
 #[cfg(test)]
@@ -307,6 +303,24 @@ mod tests {
             e.contains(":2: field week: a GPS week is a whole number"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn any_separator_and_comments() {
+        let text =
+            b"# truth\n0\t1.0;45;7;100;0;0;0;0;0;10\n\n0, 2.0, 45, 7, 100, 0, 0, 0, 0, 0, 10\n";
+        let (format, rows) = read_nav(file(text).path()).expect("reads");
+        assert_eq!(format, NavFormat::KfGins);
+        assert_eq!((rows[0].t_sow, rows[1].t_sow), (1.0, 2.0));
+        let csv =
+            b"% semicolons\nt_sow;lat_deg;lon_deg;h_m;vn_mps;ve_mps;vd_mps;roll_deg;pitch_deg;\
+                    yaw_deg\n1;45;7;100;0;0;0;0;0;10\n";
+        let (format, csv_rows) = read_nav(file(csv).path()).expect("reads");
+        assert_eq!(format, NavFormat::Csv);
+        assert_eq!(csv_rows[0], rows[0]);
+        let tabs = b"t_sow\tlat_deg\tlon_deg\th_m\tvn_mps\tve_mps\tvd_mps\troll_deg\tpitch_deg\t\
+                     yaw_deg\n1\t45\t7\t100\t0\t0\t0\t0\t0\t10\n";
+        assert_eq!(read_nav(file(tabs).path()).expect("reads").1, csv_rows);
     }
 
     #[test]

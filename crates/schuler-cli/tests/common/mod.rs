@@ -62,12 +62,22 @@ pub fn simulate_drive(dir: &Path) -> PathBuf {
 /// `schuler nav --gnss` of the simulated drive into `out` (its initial state, lever
 /// arm and IMU grade, 10-Hz output), with `extra` flags.
 pub fn nav_drive(sim: &Path, out: &Path, extra: &[&std::ffi::OsStr]) -> assert_cmd::assert::Assert {
+    let gnss = sim.join("gnss.txt");
+    nav_drive_gnss(sim, out, &["--gnss".as_ref(), gnss.as_os_str()], extra)
+}
+
+/// [`nav_drive`] with the GNSS flags `gnss` in place of `--gnss sim/gnss.txt`.
+pub fn nav_drive_gnss(
+    sim: &Path,
+    out: &Path,
+    gnss: &[&std::ffi::OsStr],
+    extra: &[&std::ffi::OsStr],
+) -> assert_cmd::assert::Assert {
     assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .args(["nav", "--imu"])
         .arg(sim.join("imu.txt"))
-        .arg("--gnss")
-        .arg(sim.join("gnss.txt"))
+        .args(gnss)
         .args(["--init-pos", "45.07,7.68,245", "--init-att", "0,0,10"])
         .args([
             "--lever-arm",
