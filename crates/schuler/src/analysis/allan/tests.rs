@@ -156,6 +156,17 @@ fn slope(c: &AllanCurve, range: (f64, f64)) -> f64 {
     sxy / sxx
 }
 
+/// The IEEE 952 fit of the increments `x` checked against `truths` ([`check_fit`]),
+/// and the slope of the curve over `range` ([`slope`]).
+fn fit_and_slope(what: &str, x: &[f64], dt: f64, truths: &[(Term, f64)], range: (f64, f64)) -> f64 {
+    let c = curve(x, dt);
+    let fit = fit_ieee952(&c, &FitOptions::default()).expect("fit");
+    check_fit(what, &fit, truths);
+    let s = slope(&c, range);
+    eprintln!("{what}: slope {s:.4}");
+    s
+}
+
 /// A constant rate has zero Allan deviation (second differences of a line).
 #[test]
 fn constant_rate_has_zero_deviation() {
@@ -265,20 +276,19 @@ fn short_logs_and_bad_samples_are_refused() {
 #[test]
 fn white_noise_density() {
     let (dt, n) = (0.01, 1e-4);
-    let c = curve(&white(1, n, dt, 360_000), dt);
-    let fit = fit_ieee952(&c, &FitOptions::default()).expect("fit");
-    check_fit(
+    let truths = [
+        (Term::WhiteRate, n),
+        (Term::Quantization, 0.0),
+        (Term::BiasInstability, 0.0),
+        (Term::RateRandomWalk, 0.0),
+    ];
+    let s = fit_and_slope(
         "white",
-        &fit,
-        &[
-            (Term::WhiteRate, n),
-            (Term::Quantization, 0.0),
-            (Term::BiasInstability, 0.0),
-            (Term::RateRandomWalk, 0.0),
-        ],
+        &white(1, n, dt, 360_000),
+        dt,
+        &truths,
+        (0.01, 36.0),
     );
-    let s = slope(&c, (0.01, 36.0));
-    eprintln!("white: slope {s:.4}");
     assert!((s + 0.5).abs() < 0.01, "{s}");
 }
 
@@ -292,15 +302,8 @@ fn white_noise_density() {
 fn rate_random_walk() {
     let (dt, n, k, len) = (0.1, 1e-5, 1e-5, 360_000);
     let x = add(&white(2, n, dt, len), &random_walk(3, k, dt, len));
-    let c = curve(&x, dt);
-    let fit = fit_ieee952(&c, &FitOptions::default()).expect("fit");
-    check_fit(
-        "random walk",
-        &fit,
-        &[(Term::WhiteRate, n), (Term::RateRandomWalk, k)],
-    );
-    let s = slope(&c, (10.0, 360.0));
-    eprintln!("random walk: slope {s:.4}");
+    let truths = [(Term::WhiteRate, n), (Term::RateRandomWalk, k)];
+    let s = fit_and_slope("random walk", &x, dt, &truths, (10.0, 360.0));
     assert!((s - 0.5).abs() < 0.05, "{s}");
 }
 
@@ -311,15 +314,8 @@ fn rate_random_walk() {
 fn flicker_floor() {
     let (dt, n, b, len) = (0.01, 1e-5, 2e-5, 1 << 18);
     let x = add(&white(4, n, dt, len), &flicker(5, b, dt, len));
-    let c = curve(&x, dt);
-    let fit = fit_ieee952(&c, &FitOptions::default()).expect("fit");
-    check_fit(
-        "flicker",
-        &fit,
-        &[(Term::WhiteRate, n), (Term::BiasInstability, b)],
-    );
-    let s = slope(&c, (10.0, 260.0));
-    eprintln!("flicker: slope {s:.4}");
+    let truths = [(Term::WhiteRate, n), (Term::BiasInstability, b)];
+    let s = fit_and_slope("flicker", &x, dt, &truths, (10.0, 260.0));
     assert!(s.abs() < 0.1, "{s}");
 }
 
