@@ -75,8 +75,9 @@ pub enum Term {
 /// The IEEE Std 952 terms [`fit_ieee952`] fits: quantization, white noise, bias
 /// instability and rate random walk. The rate ramp is left out: over a log a few
 /// times longer than the longest `τ` it is hard to tell from the random walk, and the
-/// few degrees of freedom of the last points make it appear in a quarter of pure
-/// noise runs (tests); give it to [`fit_terms`] to fit it too.
+/// few degrees of freedom of the last points made its 95 % interval exclude zero in 24
+/// of 100 seeded runs of white noise and random walk without any ramp; give it to
+/// [`fit_terms`] to fit it too.
 pub const IEEE952_TERMS: [Term; 4] = [
     Term::Quantization,
     Term::WhiteRate,
