@@ -168,6 +168,13 @@ pub struct AidingOptions {
     /// modelled as first-order Gauss–Markov processes, otherwise as random walks.
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
     pub bias_corr_time: Option<String>,
+    /// Gyro rate random walk (e.g. `0.01 deg/h/sqrt(h)`): added in quadrature to the
+    /// gyro bias's driving noise (the instability's, or --imu-grade's).
+    #[arg(long, allow_hyphen_values = true, value_name = "RRW")]
+    pub rate_random_walk: Option<String>,
+    /// Accelerometer acceleration random walk (e.g. `10 ug/sqrt(h)`), likewise.
+    #[arg(long, allow_hyphen_values = true, value_name = "ARW")]
+    pub acceleration_random_walk: Option<String>,
     /// Initial position standard deviation north, east, down [m] (default 1,1,1).
     #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
     pub init_pos_std: Option<Triple>,
@@ -317,6 +324,8 @@ impl AidingOptions {
             gyro_bias_instability,
             accel_bias_instability,
             bias_corr_time,
+            rate_random_walk,
+            acceleration_random_walk,
             init_pos_std,
             init_vel_std,
             init_att_std,
@@ -541,6 +550,24 @@ impl AidingOptions {
         if let Some(x) = accel {
             noise.accel_bias_walk = walk(x);
         }
+        let add = |w: &mut Vector3<f64>, k: Option<f64>| {
+            if let Some(k) = k {
+                *w = w.map(|x| x.hypot(k));
+            }
+        };
+        let (rrw, arw) = (&self.rate_random_walk, &self.acceleration_random_walk);
+        add(
+            &mut noise.gyro_bias_walk,
+            q("rate-random-walk", rrw, Dimension::RateRandomWalk)?,
+        );
+        add(
+            &mut noise.accel_bias_walk,
+            q(
+                "acceleration-random-walk",
+                arw,
+                Dimension::AccelerationRandomWalk,
+            )?,
+        );
         Ok(noise)
     }
 

@@ -2,6 +2,7 @@
 //! calls to readers and writers.
 
 pub mod align;
+pub mod allan;
 pub mod channel;
 pub mod compare;
 pub mod demo;

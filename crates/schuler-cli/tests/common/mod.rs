@@ -46,12 +46,17 @@ pub fn read_rows(path: &Path) -> Vec<Vec<f64>> {
 /// tactical IMU at 200 Hz, GNSS at 1 Hz with a lever arm and a 60-s outage at
 /// 400-460 s, a barometer with a 3-m bias) into `dir/sim`.
 pub fn simulate_drive(dir: &Path) -> PathBuf {
-    let sim = dir.join("sim");
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drive.toml");
+    simulate(&example, dir)
+}
+
+/// `schuler simulate` of the scenario `config` into `dir/sim`.
+pub fn simulate(config: &Path, dir: &Path) -> PathBuf {
+    let sim = dir.join("sim");
     assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .args(["simulate", "--config"])
-        .arg(&example)
+        .arg(config)
         .arg("--out")
         .arg(&sim)
         .assert()
