@@ -163,10 +163,14 @@ fn fits_the_simulated_noise_and_feeds_nav() {
     ] {
         assert!(aiding.contains_key(key), "{key} in {noise}");
     }
+    nav_reads_the_noise_file(dir.path(), &sim, &out_dir.join("imu_noise.toml"));
+}
 
-    // nav reads the file: it runs, and its filter differs from the grade default's.
+/// `schuler nav` reads the fitted noise file: it runs, and its filter differs from the
+/// grade default's.
+fn nav_reads_the_noise_file(dir: &Path, sim: &Path, noise_file: &Path) {
     let nav = |name: &str, config: Option<&Path>| {
-        let out = dir.path().join(name);
+        let out = dir.join(name);
         let mut cmd = schuler();
         cmd.arg("nav");
         if let Some(c) = config {
@@ -191,7 +195,7 @@ fn fits_the_simulated_noise_and_feeds_nav() {
             .success();
         std::fs::read_to_string(out.join("std.txt")).expect("std.txt")
     };
-    let with = nav("nav_allan", Some(&out_dir.join("imu_noise.toml")));
+    let with = nav("nav_allan", Some(noise_file));
     let without = nav("nav_grade", None);
     assert_ne!(with, without, "the noise keys change the filter");
 }

@@ -479,7 +479,8 @@ impl AidingOptions {
         Ok(fixes)
     }
 
-    /// The IMU noise model with the flags' overrides.
+    /// The IMU noise model with the flags' overrides: white noise, bias and scale
+    /// priors, then [`AidingOptions::bias_walks`].
     fn noise(&self, mut noise: ImuNoise) -> Result<ImuNoise> {
         let q = quantity;
         let set = |v: &mut Vector3<f64>, x: Option<f64>| {
@@ -523,6 +524,13 @@ impl AidingOptions {
                 Dimension::Dimensionless,
             )?,
         );
+        self.bias_walks(noise)
+    }
+
+    /// The noise model's bias processes with the flags' overrides: Gauss–Markov
+    /// correlation time, instabilities and random walks.
+    fn bias_walks(&self, mut noise: ImuNoise) -> Result<ImuNoise> {
+        let q = quantity;
         let tau_given = q("bias-corr-time", &self.bias_corr_time, Dimension::Time)?;
         let tau = tau_given.unwrap_or(3600.0);
         if tau <= 0.0 {
