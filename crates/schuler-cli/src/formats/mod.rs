@@ -7,7 +7,9 @@
 
 pub mod error;
 pub mod gnss;
+pub mod imu_columns;
 pub mod imu_log;
+pub mod imu_plausibility;
 mod lines;
 pub mod nav;
 pub mod sensor_errors;
