@@ -62,10 +62,21 @@ pub fn simulate_drive(dir: &Path) -> PathBuf {
 /// `schuler nav --gnss` of the simulated drive into `out` (its initial state, lever
 /// arm and IMU grade, 10-Hz output), with `extra` flags.
 pub fn nav_drive(sim: &Path, out: &Path, extra: &[&std::ffi::OsStr]) -> assert_cmd::assert::Assert {
+    nav_drive_imu(sim, &sim.join("imu.txt"), out, extra)
+}
+
+/// [`nav_drive`] on another IMU file than the simulated one (the same drive written
+/// otherwise).
+pub fn nav_drive_imu(
+    sim: &Path,
+    imu: &Path,
+    out: &Path,
+    extra: &[&std::ffi::OsStr],
+) -> assert_cmd::assert::Assert {
     assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .args(["nav", "--imu"])
-        .arg(sim.join("imu.txt"))
+        .arg(imu)
         .arg("--gnss")
         .arg(sim.join("gnss.txt"))
         .args(["--init-pos", "45.07,7.68,245", "--init-att", "0,0,10"])
