@@ -621,7 +621,7 @@ fn stamp_seconds(field: &[u8], value: f64, unit: TimeUnit, offset: f64) -> f64 {
 }
 
 /// Median of `values` (sorted in place); `None` if empty.
-fn median(values: &mut [f64]) -> Option<f64> {
+pub(super) fn median(values: &mut [f64]) -> Option<f64> {
     if values.is_empty() {
         return None;
     }

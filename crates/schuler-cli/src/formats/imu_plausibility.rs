@@ -12,14 +12,16 @@
 //! A file that fails is read again under every combination of the usual mistakes:
 //! gyro and accelerometer columns exchanged, rates taken for increments or the
 //! reverse, the accelerometer in g or in m/s², the gyro in deg or rad (per second or
-//! not), the time in ms, µs or ns; the combination that passes with the fewest flags
-//! (then the specific force nearest 1 g) is named in the error, with the flags that
-//! read the file so.
+//! not), the time in ms, µs or ns. Of the combinations that pass, those that look at
+//! rest come first ([`AT_REST_FACTOR`], but not with a gyro quieter than the Earth's
+//! rate, [`QUIET_GYRO_DEG_S`]), then the fewest flags, then the specific force
+//! nearest 1 g; the first is named in the error with the flags that read the file so.
+//! At rest a gyro's deg/s cannot be told from rad/s, which the error then says.
 
 use nalgebra::Vector3;
 
 use super::imu_columns::{AccelUnit, GyroUnit, Plan, TimeUnit, spec_text};
-use super::imu_log::{ImuLayout, STANDARD_GRAVITY};
+use super::imu_log::{ImuLayout, STANDARD_GRAVITY, median};
 
 /// Longest plausible median sample interval [s]: an IMU sampled more slowly than 1 Hz
 /// cannot be navigated (the motion between samples is unknown), while times in ms,
@@ -67,7 +69,7 @@ pub const QUIET_GYRO_DEG_S: f64 = 0.002;
 /// written (not yet scaled to SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Reading {
-    /// Interval [s] in the declared time unit.
+    /// Interval in ticks of the declared time unit (seconds for `s`).
     pub dt: f64,
     /// The gyro columns.
     pub gyro: Vector3<f64>,
@@ -118,17 +120,6 @@ struct Medians {
     steady: bool,
 }
 
-/// Median of `values` (sorted in place); NaN if empty.
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_unstable_by(f64::total_cmp);
-    let n = values.len();
-    match n {
-        0 => f64::NAN,
-        _ if n % 2 == 1 => values[n / 2],
-        _ => 0.5 * (values[n / 2 - 1] + values[n / 2]),
-    }
-}
-
 impl Interpretation {
     /// The medians of `readings` (intervals in ticks of the declared time unit) read
     /// this way.
@@ -166,9 +157,9 @@ impl Interpretation {
             / n.max(1) as f64)
             .sqrt();
         Medians {
-            dt: median(&mut dts),
-            f_g: median(&mut fs),
-            w_deg_s: median(&mut ws),
+            dt: median(&mut dts).unwrap_or(f64::NAN),
+            f_g: median(&mut fs).unwrap_or(f64::NAN),
+            w_deg_s: median(&mut ws).unwrap_or(f64::NAN),
             steady: scatter < STEADY_SPREAD * mean.norm(),
         }
     }
