@@ -629,7 +629,7 @@ fn header_layout(
             } else {
                 return Err(PlanError::usage(
                     "imu_layout",
-                    format!("the {what}'s names say {other}, {flag} says {l}"),
+                    format!("the names of {what} say {other}, {flag} says {l}"),
                 ));
             }
         }
@@ -738,11 +738,11 @@ fn unit_in_names(
 }
 
 /// The error of an option `flag` = `value` that contradicts the column `name` of
-/// `what` (the header or `--imu-columns`).
+/// `what` ("the header" or "--imu-columns").
 fn contradiction(flag: &str, value: impl fmt::Display, what: &str, name: &str) -> PlanError {
     PlanError::usage(
         &flag.replace('-', "_"),
-        format!("--{flag} {value} contradicts the {what}'s column {name:?}"),
+        format!("--{flag} {value} contradicts the column {name:?} of {what}"),
     )
 }
 
@@ -772,7 +772,7 @@ fn gyro_unit(
 }
 
 /// The plan of a header's (or `--imu-columns`') names, with the declarations applied;
-/// `what` names the source in messages ("header" or "--imu-columns").
+/// `what` names the source in messages ("the header" or "--imu-columns").
 pub(crate) fn plan(
     names: &[String],
     cols: &[Option<ColumnName>],
@@ -985,7 +985,7 @@ mod tests {
     fn plan_of(header: &str, declared: &Declared) -> Result<Plan, PlanError> {
         let names: Vec<String> = header.split(',').map(str::to_owned).collect();
         let cols: Vec<_> = names.iter().map(|n| recognise(n).expect("ok")).collect();
-        plan(&names, &cols, declared, "header")
+        plan(&names, &cols, declared, "the header")
     }
 
     #[test]
@@ -1053,7 +1053,7 @@ mod tests {
         .expect_err("rates unit for increments");
         assert!(
             e.message
-                .contains("the header's names say increments, --accel-unit g says rates"),
+                .contains("the names of the header say increments, --accel-unit g says rates"),
             "{}",
             e.message
         );
@@ -1065,7 +1065,7 @@ mod tests {
             },
         )
         .expect_err("missing");
-        assert_eq!(e.message, "header lacks column(s) f_z for rates");
+        assert_eq!(e.message, "the header lacks column(s) f_z for rates");
         let e = plan_of("t,x,y,z", &none).expect_err("nothing");
         assert!(e.message.contains("recognised: time t"), "{}", e.message);
         let e = Declared {

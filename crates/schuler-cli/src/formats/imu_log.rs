@@ -789,7 +789,7 @@ impl<R: BufRead> ImuReader<R> {
                     .map(|n| recognise(n))
                     .collect::<Result<Vec<_>, _>>()
                     .map_err(|m| self.plan_error(PlanError::header(None, m)))?;
-                let plan = plan(&names, &cols, &declared, "header");
+                let plan = plan(&names, &cols, &declared, "the header");
                 (plan, names, false)
             }
             (None, false) => {
@@ -1896,7 +1896,7 @@ mod tests {
             0,
             Some("imu_layout"),
             InputErrorKind::Usage,
-            "the header's names say rates, --gyro-unit rad says increments",
+            "the names of the header say rates, --gyro-unit rad says increments",
         );
         let e = read_err(
             "1 0 0 0 0 0 0\n",
@@ -1918,7 +1918,7 @@ mod tests {
             0,
             Some("accel_unit"),
             InputErrorKind::Usage,
-            "contradicts the header's column \"ax_g\"",
+            "contradicts the column \"ax_g\" of the header",
         );
     }
 
