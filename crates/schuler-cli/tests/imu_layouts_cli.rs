@@ -413,3 +413,69 @@ fn a_real_device_reads_with_its_flags() {
     );
     assert!(e.contains("median sample interval is 1.002e6 s"), "{e}");
 }
+
+/// The same options as keys of `nav --config` and as flags of `schuler align`: the
+/// rover's file configured in TOML navigates to the flags' nav.txt byte for byte, and
+/// aligns at rest to the canonical file's attitude within 1e-9 deg (the round-off of
+/// its deg/s and g digits; the printed attitude has 1e-4 deg).
+#[test]
+fn config_keys_and_align_take_the_same_options() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sim = common::simulate_drive(dir.path());
+    let rows: Vec<Row> = canonical(&sim)
+        .into_iter()
+        .take_while(|r| r.t <= 100.0)
+        .collect();
+    let rover = variants().pop().expect("the rover");
+    let imu = dir.path().join("rover.csv");
+    rover.write(&imu, &rows);
+    let flags: Vec<&str> = rover.flags.split(' ').collect();
+    let short = ["--end", "100", "--no-report"].map(OsStr::new);
+    let mut with_flags: Vec<&OsStr> = flags.iter().map(OsStr::new).collect();
+    with_flags.extend(short);
+    common::nav_drive_imu(&sim, &imu, &dir.path().join("flags"), &with_flags).success();
+    let config = dir.path().join("rover.toml");
+    std::fs::write(
+        &config,
+        "imu_columns = \"t,fx,fy,fz,wx,wy,wz\"\ngyro_unit = \"deg/s\"\naccel_unit = \"g\"\n\
+         imu_time_unit = \"ns\"\nimu_time_offset = -1000\nimu_axes = \"RBD\"\n",
+    )
+    .expect("write config");
+    let mut with_config = vec![OsStr::new("--config"), config.as_os_str()];
+    with_config.extend(short);
+    common::nav_drive_imu(&sim, &imu, &dir.path().join("config"), &with_config).success();
+    let read = |d: &str| std::fs::read(dir.path().join(d).join("nav.txt")).expect("nav.txt");
+    assert!(
+        read("flags") == read("config"),
+        "config keys and flags differ"
+    );
+    let align = |file: &Path, extra: &[&str], out: &str| {
+        assert_cmd::Command::cargo_bin("schuler")
+            .expect("binary")
+            .args([
+                "align",
+                "--pos",
+                "45.07,7.68,245",
+                "--coarse",
+                "20s",
+                "--fine",
+                "30s",
+            ])
+            .args(["--heading", "10", "--imu"])
+            .arg(file)
+            .args(extra)
+            .arg("--out")
+            .arg(dir.path().join(out))
+            .assert()
+            .success();
+        let text = std::fs::read_to_string(dir.path().join(out).join("align.json")).expect("json");
+        let v: serde_json::Value = serde_json::from_str(&text).expect("json");
+        ["roll_deg", "pitch_deg", "yaw_deg"].map(|k| v[k].as_f64().expect("number"))
+    };
+    let canonical = align(&sim.join("imu.txt"), &[], "align_canonical");
+    let device = align(&imu, &flags, "align_rover");
+    println!("align roll, pitch, yaw [deg]: canonical {canonical:?}, rover {device:?}");
+    for (a, b) in canonical.iter().zip(device) {
+        assert!((a - b).abs() < 1e-9, "{canonical:?} vs {device:?}");
+    }
+}
