@@ -779,7 +779,13 @@ impl<R: BufRead> ImuReader<R> {
         let (plan, names, trailing) = match (&options.columns, csv) {
             (Some(spec), _) => {
                 let names = spec.names().to_vec();
-                let plan = plan(&names, spec.columns(), &declared, "--imu-columns");
+                // Whatever is wrong is in the options, not in the file.
+                let plan = plan(&names, spec.columns(), &declared, "--imu-columns").map_err(|e| {
+                    PlanError {
+                        in_header: false,
+                        ..e
+                    }
+                });
                 (plan, names, spec.trailing())
             }
             (None, true) => {
@@ -1828,6 +1834,23 @@ mod tests {
             None,
             InputErrorKind::ColumnCount,
             "expected at least 8 columns, found 7",
+        );
+    }
+
+    /// A unit `--imu-columns` leaves open is the options' fault, not the file's.
+    #[test]
+    fn an_ambiguous_spec_is_a_usage_error() {
+        let ambiguous = ImuReadOptions {
+            columns: Some(ColumnSpec::parse("t,gx_deg,gy_deg,gz_deg,ax,ay,az").expect("spec")),
+            ..text()
+        };
+        let e = read_err("1 0 0 0 0 0 0\n", &ambiguous);
+        assert_err(
+            &e,
+            0,
+            Some("gx_deg"),
+            InputErrorKind::Usage,
+            "give --gyro-unit deg or --gyro-unit deg/s",
         );
     }
 
