@@ -12,7 +12,7 @@ use toml::de::{DeTable, Deserializer};
 
 use crate::formats::ImuReadOptions;
 use crate::formats::imu_columns::{AccelUnit, ColumnSpec, GyroUnit, TimeUnit};
-use crate::options::{FormatChoice, LayoutChoice, Triple};
+use crate::options::{FormatChoice, LayoutChoice, Triple, rate};
 
 /// The IMU log's reading options (see [`crate::formats::imu_log`]).
 #[derive(clap::Args, Debug, Default, Clone, PartialEq, Deserialize)]
@@ -149,11 +149,7 @@ impl ImuInputOptions {
     /// The reader's options, with the time window `t_start`, `t_end`; each value
     /// checked, errors naming the flag.
     pub fn read_options(&self, t_start: Option<f64>, t_end: Option<f64>) -> Result<ImuReadOptions> {
-        if let Some(r) = self.imu_rate
-            && !(r.is_finite() && r > 0.0)
-        {
-            bail!("--imu-rate must be a positive number of Hz, got {r}");
-        }
+        let imu_rate = rate("imu-rate", self.imu_rate)?;
         if let Some(s) = self.imu_time_offset
             && !s.is_finite()
         {
@@ -176,7 +172,7 @@ impl ImuInputOptions {
             time_unit: self.imu_time_unit,
             time_offset: self.imu_time_offset.unwrap_or(0.0),
             c_vs: self.c_vs()?,
-            nominal_dt: self.imu_rate.map(|r| 1.0 / r),
+            nominal_dt: imu_rate.map(|r| 1.0 / r),
             t_start,
             t_end,
             check_layout: !self.no_layout_check,

@@ -19,7 +19,7 @@ use crate::alignment::AlignOptions;
 use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
-use crate::options::{EarthChoice, GradeChoice, MechanizationChoice, Triple};
+use crate::options::{EarthChoice, GradeChoice, MechanizationChoice, Triple, rate};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
@@ -227,16 +227,6 @@ fn init_att(args: &NavArgs, cfg: &NavConfig, align_on: bool) -> Result<Euler> {
         bail!("--init-att: pitch {pitch} deg is outside [-90, 90]");
     }
     Ok(Euler::from_degrees(roll, pitch, yaw))
-}
-
-/// A rate flag [Hz], checked positive.
-fn rate(flag: &str, r: Option<f64>) -> Result<Option<f64>> {
-    if let Some(r) = r
-        && !(r.is_finite() && r > 0.0)
-    {
-        bail!("--{flag} must be a positive number of Hz, got {r}");
-    }
-    Ok(r)
 }
 
 /// The IMU reader's options of flags over config, checked.
