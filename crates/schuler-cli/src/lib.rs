@@ -7,6 +7,7 @@ pub mod commands;
 pub mod drive;
 pub mod fixed;
 pub mod formats;
+pub mod imu_input;
 pub mod navigate;
 pub mod options;
 pub mod output;

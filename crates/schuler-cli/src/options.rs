@@ -151,6 +151,16 @@ impl GradeChoice {
     }
 }
 
+/// A rate flag [Hz], checked positive.
+pub fn rate(flag: &str, r: Option<f64>) -> Result<Option<f64>> {
+    if let Some(r) = r
+        && !(r.is_finite() && r > 0.0)
+    {
+        bail!("--{flag} must be a positive number of Hz, got {r}");
+    }
+    Ok(r)
+}
+
 /// The value of an aiding option given with a unit (or as a bare SI number), checked
 /// finite and not negative; errors name the flag.
 pub fn quantity(

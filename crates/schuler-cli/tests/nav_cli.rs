@@ -128,14 +128,25 @@ fn repeated_time_is_an_error() {
     );
 }
 
-/// Rates where increments are expected: dvel holds -9.8 m/s^2, implying 200 g at 200 Hz.
+/// Rates where increments are expected: dvel holds -9.8 m/s^2, implying 200 g at 200
+/// Hz, and the gyro columns rates too; the error names the reading that fits.
 #[test]
 fn rates_in_an_increment_file_are_an_error() {
+    rejects(
+        |_, l| {
+            l.replace(&format!("{:.9e}", -9.80 * 0.005), "-9.8")
+                .replace("1.2e-7 -3.0e-8 2.9e-7", "2.4e-5 -6.0e-6 5.8e-5")
+        },
+        1,
+        "dvel",
+        "look like rates, not increments",
+    );
+    // Accelerometer rates beside gyro increments: refused, with the numbers.
     rejects(
         |_, l| l.replace(&format!("{:.9e}", -9.80 * 0.005), "-9.8"),
         1,
         "dvel",
-        "rates",
+        "median specific force is 199.9 g, above the 50 g",
     );
 }
 

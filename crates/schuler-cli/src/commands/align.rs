@@ -4,8 +4,9 @@
 //! `schuler nav --align` ([`crate::alignment`]).
 
 use crate::alignment::{AlignOptions, align_on, read_stage, summary_text, write_outputs};
-use crate::formats::{ImuReadOptions, ImuReader};
-use crate::options::{EarthChoice, FormatChoice, LayoutChoice, Triple};
+use crate::formats::ImuReader;
+use crate::imu_input::ImuInputOptions;
+use crate::options::{EarthChoice, Triple};
 use anyhow::{Context, Result, bail};
 use schuler::earth::Geodetic;
 use std::path::PathBuf;
@@ -32,12 +33,9 @@ pub struct Args {
     /// Earth model.
     #[arg(long, value_enum, default_value = "wgs84")]
     pub earth: EarthChoice,
-    /// IMU file format.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub imu_format: FormatChoice,
-    /// Increments or rates in the IMU columns.
-    #[arg(long, value_enum)]
-    pub imu_layout: Option<LayoutChoice>,
+    /// How to read the IMU log: format, layout, columns, units, clock, axes.
+    #[command(flatten)]
+    pub input: ImuInputOptions,
 }
 
 /// `schuler align`.
@@ -48,14 +46,7 @@ pub fn run(args: Args) -> Result<()> {
         bail!("--pos: latitude {lat} deg is outside [-90, 90]");
     }
     let pos = Geodetic::from_degrees(lat, lon, h);
-    let read = ImuReadOptions {
-        format: args.imu_format.format(),
-        layout: args.imu_layout.map(LayoutChoice::layout),
-        nominal_dt: None,
-        t_start: args.start,
-        t_end: None,
-        check_layout: true,
-    };
+    let read = args.input.read_options(args.start, None)?;
     let started = Instant::now();
     let mut reader = ImuReader::open(&args.imu, &read)?;
     let samples = read_stage(&mut reader, cfg.coarse + cfg.fine)?;

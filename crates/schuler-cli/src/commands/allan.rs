@@ -199,7 +199,7 @@ fn read(args: &Args) -> Result<(Vec<ImuSample>, Option<String>)> {
         nominal_dt: None,
         t_start: args.start,
         t_end: args.end,
-        check_layout: true,
+        ..ImuReadOptions::default()
     };
     let mut reader = ImuReader::open(&args.imu, &options)?;
     let samples = (&mut reader).collect::<Result<Vec<_>, _>>()?;

@@ -194,6 +194,7 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
             t_start: Some(y.starttime),
             t_end: (y.endtime >= 0.0).then_some(y.endtime),
             check_layout: true,
+            ..ImuReadOptions::default()
         },
         init_pos: Geodetic::from_degrees(y.initpos[0], y.initpos[1], y.initpos[2]),
         init_vel: Vector3::from(y.initvel),

@@ -17,10 +17,9 @@
 use crate::aided::{Aiding, AidingOptions};
 use crate::alignment::AlignOptions;
 use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
+use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
-use crate::options::{
-    EarthChoice, FormatChoice, GradeChoice, LayoutChoice, MechanizationChoice, Triple,
-};
+use crate::options::{EarthChoice, GradeChoice, MechanizationChoice, Triple, rate};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
@@ -68,23 +67,12 @@ pub struct NavArgs {
     /// Earth model.
     #[arg(long, value_enum)]
     pub earth: Option<EarthChoice>,
-    /// IMU file format.
-    #[arg(long, value_enum)]
-    pub imu_format: Option<FormatChoice>,
-    /// Whether the IMU columns hold increments or rates (default: increments for
-    /// KF-GINS text, the header's names for CSV).
-    #[arg(long, value_enum)]
-    pub imu_layout: Option<LayoutChoice>,
-    /// Nominal IMU rate [Hz] (default: estimated from the first intervals).
-    #[arg(long, value_name = "HZ")]
-    pub imu_rate: Option<f64>,
+    /// How to read the IMU log: format, layout, columns, units, clock, axes.
+    #[command(flatten)]
+    pub input: ImuInputOptions,
     /// GPS week written in the first column of nav.txt (default 0, as KF-GINS).
     #[arg(long)]
     pub week: Option<u32>,
-    /// Skip the check that accelerometer magnitudes match the declared layout (for
-    /// free fall, centrifuges and other starts far from 1 g).
-    #[arg(long)]
-    pub no_layout_check: bool,
     /// Strapdown mechanization (default auto: NED, wander at high latitude).
     #[arg(long, value_enum)]
     pub mechanization: Option<MechanizationChoice>,
@@ -133,11 +121,7 @@ struct NavConfig {
     output_rate: Option<f64>,
     out: Option<PathBuf>,
     earth: Option<EarthChoice>,
-    imu_format: Option<FormatChoice>,
-    imu_layout: Option<LayoutChoice>,
-    imu_rate: Option<f64>,
     week: Option<u32>,
-    no_layout_check: Option<bool>,
     mechanization: Option<MechanizationChoice>,
     auto_latitude: Option<f64>,
     auto_hysteresis: Option<f64>,
@@ -145,6 +129,9 @@ struct NavConfig {
     init: Option<InitChoice>,
     alignment: Option<AlignOptions>,
     aiding: Option<AidingOptions>,
+    /// The IMU input keys, read apart ([`ImuInputOptions::split_config`]).
+    #[serde(skip)]
+    input: ImuInputOptions,
 }
 
 /// How a run starts.
@@ -165,8 +152,9 @@ pub enum InitChoice {
 fn load_config(path: &Path) -> Result<NavConfig> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut cfg: NavConfig =
-        toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
+    let (mut cfg, input): (NavConfig, _) =
+        ImuInputOptions::split_config(&text).with_context(|| format!("in {}", path.display()))?;
+    cfg.input = input;
     let base = path.parent().unwrap_or(Path::new(""));
     for p in [&mut cfg.imu, &mut cfg.out].into_iter().flatten() {
         if p.is_relative() {
@@ -247,37 +235,18 @@ fn init_att(args: &NavArgs, cfg: &NavConfig, align_on: bool) -> Result<Euler> {
     Ok(Euler::from_degrees(roll, pitch, yaw))
 }
 
-/// A rate flag [Hz], checked positive.
-fn rate(flag: &str, r: Option<f64>) -> Result<Option<f64>> {
-    if let Some(r) = r
-        && !(r.is_finite() && r > 0.0)
-    {
-        bail!("--{flag} must be a positive number of Hz, got {r}");
-    }
-    Ok(r)
-}
-
 /// The IMU reader's options of flags over config, checked.
 fn read_options(args: &NavArgs, cfg: &NavConfig) -> Result<ImuReadOptions> {
-    let imu_rate = rate("imu-rate", args.imu_rate.or(cfg.imu_rate))?;
     let (start, end) = (args.start.or(cfg.start), args.end.or(cfg.end));
     if let (Some(s), Some(e)) = (start, end)
         && s >= e
     {
         bail!("--start {s} is not before --end {e}");
     }
-    Ok(ImuReadOptions {
-        format: args
-            .imu_format
-            .or(cfg.imu_format)
-            .unwrap_or_default()
-            .format(),
-        layout: args.imu_layout.or(cfg.imu_layout).map(LayoutChoice::layout),
-        nominal_dt: imu_rate.map(|r| 1.0 / r),
-        t_start: start,
-        t_end: end,
-        check_layout: !(args.no_layout_check || cfg.no_layout_check.unwrap_or(false)),
-    })
+    args.input
+        .clone()
+        .or(cfg.input.clone())
+        .read_options(start, end)
 }
 
 /// Merge flags over the config file and check every value (see [`NavPlan`]).

@@ -1,4 +1,5 @@
-//! Streaming IMU log readers: KF-GINS text and our CSV, to [`ImuSample`]s.
+//! Streaming IMU log readers: KF-GINS text and CSV, to [`ImuSample`]s in the vehicle's
+//! FRD axes.
 //!
 //! # Formats
 //! - **KF-GINS text** (also the awesome-gins-datasets IMU files): one sample per line,
@@ -8,18 +9,35 @@
 //!   `(t_prev, t]`, `t_prev` the previous line's time. With [`ImuLayout::Rates`] the
 //!   same columns are read as angular rate `w_x y z` [rad/s] and specific force
 //!   `f_x y z` [m/s²].
+//! - **Text in another column order** ([`ImuReadOptions::columns`], `--imu-columns`):
+//!   the same separators, the columns named by the caller (`t,fx,fy,fz,wx,wy,wz`, `_`
+//!   for a column to skip, a last `...` for further columns to ignore); the names say
+//!   rates or increments (see [`super::imu_columns`]).
 //! - **CSV** (our native format): a header row, then comma-separated rows with as many
-//!   fields as the header. Columns are found by name (ASCII case-insensitive, blanks and
-//!   double quotes around a name ignored): `t` (or `time`), then either increments
-//!   `dtheta_x, dtheta_y, dtheta_z, dvel_x, dvel_y, dvel_z` [rad, m/s] or rates
-//!   `w_x, w_y, w_z, f_x, f_y, f_z` [rad/s, m/s²]. Order is free, other columns are
-//!   ignored (and not parsed), missing ones are an error naming them. A header with
-//!   both sets reads increments unless [`ImuReadOptions::layout`] says rates. Quoted
-//!   data fields are not supported.
+//!   fields as the header. Columns are found by name (see [`super::imu_columns`] for
+//!   every name and unit recognised): `t` (or `time`, `timestamp`), then either
+//!   increments `dtheta_x, dtheta_y, dtheta_z, dvel_x, dvel_y, dvel_z` [rad, m/s] or
+//!   rates `w_x, w_y, w_z, f_x, f_y, f_z` [rad/s, m/s²], or common names such as
+//!   `gyro_x`, `acc_x`, `gx_dps`, `ax_g`. Order is free, other columns are ignored (and
+//!   not parsed), missing ones are an error naming them and listing what is
+//!   recognised. A header with both sets reads increments unless the options say
+//!   rates. With [`ImuReadOptions::columns`] the header line is skipped and the columns
+//!   are the caller's. Quoted data fields are not supported.
 //!
-//! In both, blank lines and lines whose first non-blank byte is `#` or `%` are skipped,
+//! In all, blank lines and lines whose first non-blank byte is `#` or `%` are skipped,
 //! a UTF-8 byte-order mark and `\r\n` line ends are accepted, and line numbers in
 //! errors count every line of the file (1-based).
+//!
+//! # Units, time and axes
+//! The gyro and accelerometer columns are in [`ImuReadOptions::gyro_unit`] and
+//! [`ImuReadOptions::accel_unit`] (or a unit written in the header's names; SI by
+//! default), converted to SI on reading. The time column is in seconds or in integer
+//! ticks of [`ImuReadOptions::time_unit`] (ms, µs, ns; integers are converted exactly
+//! to whole seconds and a fraction, so 19-digit UNIX nanoseconds keep their
+//! resolution), then [`ImuReadOptions::time_offset`] is added: every time the reader
+//! reports, checks or compares with the window is on that clock. Each sample's
+//! increments are then turned by [`ImuReadOptions::c_vs`] from the IMU's axes into the
+//! vehicle's FRD axes.
 //!
 //! # Time and increments
 //! A sample's `dt = t - t_prev`. The first sample of a file has no predecessor: it gets
@@ -38,7 +56,11 @@
 //! panic; the first error ends the iteration.
 //! - wrong column count, empty or non-numeric field, NaN or ±Inf (also overflow);
 //! - time going backwards or repeating (both times and lines named);
-//! - rates where increments are expected and the reverse (see [`ImuReadOptions::check_layout`]);
+//! - values a sensor on the Earth cannot read, with the flags that probably read the
+//!   file right (see [`ImuReadOptions::check_layout`] and
+//!   [`super::imu_plausibility`]);
+//! - options that contradict each other or the header (`--gyro-unit deg/s` with
+//!   `--imu-layout increments`, `--accel-unit g` with a column `acc_x_mps2`);
 //! - a line over 64 KiB (bounds memory on a file without newlines).
 //!
 //! Gaps (an interval longer than [`GAP_FACTOR`] nominal intervals) are not errors:
@@ -61,10 +83,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use schuler::imu::ImuSample;
 
 use super::error::{InputError, InputErrorKind, quote_field};
+use super::imu_columns::{
+    AccelUnit, ColumnSpec, Declared, GyroUnit, INCREMENT_NAMES, Plan, PlanError, RATE_NAMES,
+    SLOT_TIME, TimeUnit, UNUSED, default_plan, plan, recognise,
+};
+use super::imu_plausibility::{Reading, Sensor};
 use super::lines::{LineReadError, LineReader, MAX_LINE_BYTES, is_blank, is_skippable};
 
 /// Standard gravity g₀ [m/s²] (CGPM 1901), the yardstick of the layout check.
@@ -80,23 +107,6 @@ pub const GAP_FACTOR: f64 = 2.0;
 /// Fewest lookahead intervals for the layout check to run; below it the check is
 /// skipped (a median of fewer samples says too little).
 pub const LAYOUT_CHECK_MIN_INTERVALS: usize = 10;
-
-/// Range [g₀] of a plausible median specific-force magnitude over the first samples.
-///
-/// A vehicle, at rest or moving, feels gravity plus its own acceleration: the median
-/// `|f|` over a second or so sits near 1 g₀ and, outside free fall or a centrifuge,
-/// within 0.3–3 g₀.
-pub const PLAUSIBLE_SPECIFIC_FORCE_G: (f64, f64) = (0.3, 3.0);
-
-/// Median `|f|` [g₀] above which the increment hypothesis is rejected: rates read as
-/// increments give `|f| ≈ g₀/dt` (200 g₀ at 200 Hz); no vehicle this reader serves
-/// sustains 5 g₀ for its median. Rejected only if the rate hypothesis is plausible,
-/// so a 1 Hz log (where both read alike) never trips it.
-pub const IMPLAUSIBLY_HIGH_G: f64 = 5.0;
-
-/// Median `|f|` [g₀] below which the rate hypothesis is rejected: increments read as
-/// rates give `|f| ≈ g₀·dt` (0.005 g₀ at 200 Hz); the mirror of [`IMPLAUSIBLY_HIGH_G`].
-pub const IMPLAUSIBLY_LOW_G: f64 = 0.2;
 
 /// Read buffer for files [bytes].
 pub const READ_BUFFER_BYTES: usize = 1 << 20;
@@ -137,16 +147,32 @@ impl fmt::Display for ImuLayout {
 pub struct ImuReadOptions {
     /// The file format.
     pub format: ImuFormat,
-    /// The layout; `None`: increments for KF-GINS text, the header's columns for CSV.
+    /// The layout; `None`: as the units or column names say, else increments for
+    /// KF-GINS text and the header's columns for CSV.
     pub layout: Option<ImuLayout>,
+    /// The column order of a file without a header (or whose header is to be skipped).
+    pub columns: Option<ColumnSpec>,
+    /// Unit of the gyro columns; `None`: as the header's names say, else SI.
+    pub gyro_unit: Option<GyroUnit>,
+    /// Unit of the accelerometer columns; `None`: as the header's names say, else SI.
+    pub accel_unit: Option<AccelUnit>,
+    /// Unit of the time column; `None`: as the header's name says, else seconds.
+    pub time_unit: Option<TimeUnit>,
+    /// Added to every time after the unit conversion [s].
+    pub time_offset: f64,
+    /// `c_vs`, the DCM from the IMU's axes to the vehicle's FRD axes applied to every
+    /// sample; `None`: the IMU's axes are FRD.
+    pub c_vs: Option<Matrix3<f64>>,
     /// Nominal sample interval [s]; `None`: median of the first intervals.
     pub nominal_dt: Option<f64>,
-    /// Skip samples with `t < t_start` [s, log clock], checking only their time.
+    /// Skip samples with `t < t_start` [s, the reader's clock], checking only their
+    /// time.
     pub t_start: Option<f64>,
-    /// Stop at the first sample with `t > t_end` [s, log clock].
+    /// Stop at the first sample with `t > t_end` [s, the reader's clock].
     pub t_end: Option<f64>,
-    /// Reject logs whose accelerometer values look like the other layout (default on;
-    /// turn off for free fall, centrifuges or other > 3 g₀ / < 0.3 g₀ starts).
+    /// Reject logs whose first samples a sensor on the Earth cannot read (default on;
+    /// turn off for free fall, centrifuges, rockets and other starts outside
+    /// [`super::imu_plausibility`]'s bounds).
     pub check_layout: bool,
 }
 
@@ -155,10 +181,28 @@ impl Default for ImuReadOptions {
         Self {
             format: ImuFormat::Auto,
             layout: None,
+            columns: None,
+            gyro_unit: None,
+            accel_unit: None,
+            time_unit: None,
+            time_offset: 0.0,
+            c_vs: None,
             nominal_dt: None,
             t_start: None,
             t_end: None,
             check_layout: true,
+        }
+    }
+}
+
+impl ImuReadOptions {
+    /// The declarations about the sensor columns.
+    fn declared(&self) -> Declared {
+        Declared {
+            layout: self.layout,
+            gyro: self.gyro_unit,
+            accel: self.accel_unit,
+            time: self.time_unit,
         }
     }
 }
@@ -227,25 +271,35 @@ impl ProgressCounter {
     }
 }
 
-/// Canonical column names, slot order: time, gyro xyz, accelerometer xyz.
-const INCREMENT_NAMES: [&str; 7] = [
-    "t", "dtheta_x", "dtheta_y", "dtheta_z", "dvel_x", "dvel_y", "dvel_z",
-];
-const RATE_NAMES: [&str; 7] = ["t", "w_x", "w_y", "w_z", "f_x", "f_y", "f_z"];
-const TEXT_COLUMNS: usize = 7;
-/// Marks a CSV column the reader does not use.
-const UNUSED: u8 = u8::MAX;
+/// How a line's fields map to slots (0 time, 1–3 gyro, 4–6 accelerometer).
+struct Columns {
+    /// Comma-separated only (CSV), else blanks or commas (text).
+    csv: bool,
+    /// Column i's slot, or [`UNUSED`].
+    slot_of_col: Vec<u8>,
+    /// The columns' names, for messages.
+    names: Vec<String>,
+    /// The time's column.
+    time_col: usize,
+    /// Whether a line may hold further columns, ignored.
+    trailing: bool,
+}
 
-/// How a line's fields map to slots.
-enum Columns {
-    /// KF-GINS text: 7 fixed columns in slot order.
-    Text,
-    /// CSV: `slot_of_col[i]` is column i's slot (0 time, 1–6 sensors) or [`UNUSED`].
-    Csv {
-        slot_of_col: Vec<u8>,
-        names: Vec<String>,
-        time_col: usize,
-    },
+impl Columns {
+    /// KF-GINS text: 7 columns in slot order, named canonically for `layout`.
+    fn kf_gins(layout: ImuLayout) -> Self {
+        let names = match layout {
+            ImuLayout::Increments => INCREMENT_NAMES,
+            ImuLayout::Rates => RATE_NAMES,
+        };
+        Self {
+            csv: false,
+            slot_of_col: (0..7).collect(),
+            names: names.iter().map(|&n| n.to_owned()).collect(),
+            time_col: 0,
+            trailing: false,
+        }
+    }
 }
 
 /// The column names of a CSV header line: each trimmed of blanks and of one pair of
@@ -262,52 +316,6 @@ fn header_names(line: &[u8]) -> Vec<String> {
             text.trim().to_owned()
         })
         .collect()
-}
-
-/// The columns of `names` that are `wanted` (ASCII case-insensitive; `t` also as
-/// `time`, where no column is named `t`).
-fn columns_named(names: &[String], wanted: &str) -> Vec<usize> {
-    let aliases: &[&str] = if wanted == "t" {
-        &["t", "time"]
-    } else {
-        &[wanted]
-    };
-    aliases
-        .iter()
-        .map(|alias| {
-            (0..names.len())
-                .filter(|&i| names[i].eq_ignore_ascii_case(alias))
-                .collect::<Vec<_>>()
-        })
-        .find(|found| !found.is_empty())
-        .unwrap_or_default()
-}
-
-/// The layout of a header `names`: `given`, or else the one whose columns it names
-/// (all, or more of them); with its column names and those the header lacks.
-fn choose_layout(
-    names: &[String],
-    given: Option<ImuLayout>,
-) -> (ImuLayout, &'static [&'static str; 7], Vec<&'static str>) {
-    let missing = |all: &[&'static str; 7]| -> Vec<&'static str> {
-        all.iter()
-            .copied()
-            .filter(|n| columns_named(names, n).is_empty())
-            .collect()
-    };
-    let missing_inc = missing(&INCREMENT_NAMES);
-    let missing_rate = missing(&RATE_NAMES);
-    let chosen = match given {
-        Some(l) => l,
-        None if missing_inc.is_empty() => ImuLayout::Increments,
-        None if missing_rate.is_empty() => ImuLayout::Rates,
-        None if missing_rate.len() < missing_inc.len() => ImuLayout::Rates,
-        None => ImuLayout::Increments,
-    };
-    match chosen {
-        ImuLayout::Increments => (chosen, &INCREMENT_NAMES, missing_inc),
-        ImuLayout::Rates => (chosen, &RATE_NAMES, missing_rate),
-    }
 }
 
 /// A field-level parse failure, before the file and names are attached.
@@ -331,7 +339,8 @@ enum FieldError {
     },
 }
 
-/// One parsed line: time and the six sensor values as written (not yet scaled).
+/// One parsed line: time (on the reader's clock) and the six sensor values as written
+/// (not yet scaled).
 #[derive(Debug, Clone, Copy)]
 struct Record {
     t: f64,
@@ -404,12 +413,33 @@ fn count_text_fields(line: &[u8]) -> usize {
     n
 }
 
-/// Text format: parses the first `ncols` of 7 columns into `out`, and with `ncols == 7`
-/// checks that nothing follows. A trailing separator is accepted.
+/// Where the time field of the line just parsed lies (`start..end`).
+type Span = (usize, usize);
+
+/// Text format: parses the first `ncols` columns of `slots` (each column's slot, or
+/// [`UNUSED`] to skip it) into `out`, the time's span into `time`, and with `ncols ==
+/// slots.len()` and not `trailing` checks that nothing follows. A trailing separator is
+/// accepted.
 #[inline]
-fn parse_text_line(line: &[u8], ncols: usize, out: &mut [f64; 7]) -> Result<(), FieldError> {
+fn parse_text_line(
+    line: &[u8],
+    slots: &[u8],
+    ncols: usize,
+    trailing: bool,
+    out: &mut [f64; 7],
+    time: &mut Span,
+) -> Result<(), FieldError> {
     let mut pos = skip_blanks(line, 0);
-    for (col, slot) in out.iter_mut().enumerate().take(ncols) {
+    for (col, &slot) in slots.iter().enumerate().take(ncols) {
+        if slot == UNUSED && pos < line.len() {
+            let end = if line[pos] == b',' {
+                pos
+            } else {
+                text_field_end(line, pos)
+            };
+            pos = skip_text_separator(line, end);
+            continue;
+        }
         let res = if pos >= line.len() {
             Err(FieldError::Columns { found: col })
         } else if line[pos] == b',' {
@@ -419,13 +449,16 @@ fn parse_text_line(line: &[u8], ncols: usize, out: &mut [f64; 7]) -> Result<(), 
         };
         match res {
             Ok((v, end)) => {
-                *slot = v;
+                out[usize::from(slot)] = v;
+                if slot == SLOT_TIME {
+                    *time = (pos, end);
+                }
                 pos = skip_text_separator(line, end);
             }
-            Err(e) => return Err(text_error(line, e)),
+            Err(e) => return Err(text_error(line, slots.len(), trailing, e)),
         }
     }
-    if ncols == TEXT_COLUMNS && pos < line.len() {
+    if ncols == slots.len() && !trailing && pos < line.len() {
         return Err(FieldError::Columns {
             found: count_text_fields(line),
         });
@@ -433,11 +466,16 @@ fn parse_text_line(line: &[u8], ncols: usize, out: &mut [f64; 7]) -> Result<(), 
     Ok(())
 }
 
+/// Whether `found` columns are wrong where `expected` (or more, with `trailing`) are due.
+fn wrong_count(found: usize, expected: usize, trailing: bool) -> bool {
+    found < expected || (found > expected && !trailing)
+}
+
 /// Text format: a wrong column count outranks a bad field; fills in a bad field's end.
 #[cold]
-fn text_error(line: &[u8], e: FieldError) -> FieldError {
+fn text_error(line: &[u8], expected: usize, trailing: bool, e: FieldError) -> FieldError {
     let found = count_text_fields(line);
-    if found != TEXT_COLUMNS {
+    if wrong_count(found, expected, trailing) {
         return FieldError::Columns { found };
     }
     match e {
@@ -469,54 +507,56 @@ fn csv_field_bounds(line: &[u8], start: usize) -> (usize, usize) {
     (s, e)
 }
 
-/// CSV: parses the used columns of a row into `out` by `slot_of_col`. With
-/// `time_only`, parses the time column and stops there (no column count check).
+/// CSV: parses the used columns of a row into `out` by `slot_of_col`, the time's span
+/// into `time`. With `time_only`, parses the time column and stops there (no column
+/// count check); with `trailing`, further columns are allowed.
 #[inline]
 fn parse_csv_line(
     line: &[u8],
     slot_of_col: &[u8],
-    time_only: bool,
+    (time_only, trailing): (bool, bool),
     out: &mut [f64; 7],
+    time: &mut Span,
 ) -> Result<(), FieldError> {
     let len = line.len();
+    let ncols = slot_of_col.len();
+    let fail = |e| Err(csv_error(line, ncols, trailing, e));
     // Start of the current field; `len + 1` once the line has no more fields.
     let mut pos = 0;
     for (col, &slot) in slot_of_col.iter().enumerate() {
         if pos > len {
-            return Err(csv_error(
-                line,
-                slot_of_col.len(),
-                FieldError::Columns { found: col },
-            ));
+            return fail(FieldError::Columns { found: col });
         }
-        let wanted = if time_only { slot == 0 } else { slot != UNUSED };
+        let wanted = if time_only {
+            slot == SLOT_TIME
+        } else {
+            slot != UNUSED
+        };
         let next = if wanted {
             let start = skip_blanks(line, pos);
             if start >= len || line[start] == b',' {
-                return Err(csv_error(
-                    line,
-                    slot_of_col.len(),
-                    FieldError::Empty { col },
-                ));
+                return fail(FieldError::Empty { col });
             }
             let (v, end) = match parse_number(line, start, col) {
                 Ok(ok) => ok,
-                Err(e) => return Err(csv_error(line, slot_of_col.len(), e)),
+                Err(e) => return fail(e),
             };
-            let end = skip_blanks(line, end);
-            if end < len && line[end] != b',' {
-                let e = FieldError::NotANumber {
+            let after = skip_blanks(line, end);
+            if after < len && line[after] != b',' {
+                return fail(FieldError::NotANumber {
                     col,
                     start,
                     end: start,
-                };
-                return Err(csv_error(line, slot_of_col.len(), e));
+                });
             }
             out[usize::from(slot)] = v;
-            if time_only {
-                return Ok(());
+            if slot == SLOT_TIME {
+                *time = (start, end);
+                if time_only {
+                    return Ok(());
+                }
             }
-            end
+            after
         } else {
             line[pos..]
                 .iter()
@@ -525,7 +565,7 @@ fn parse_csv_line(
         };
         pos = next + 1;
     }
-    if pos <= len {
+    if pos <= len && !trailing {
         return Err(FieldError::Columns {
             found: count_csv_fields(line),
         });
@@ -535,9 +575,9 @@ fn parse_csv_line(
 
 /// CSV: a wrong column count outranks a bad field; fills in a bad field's bounds.
 #[cold]
-fn csv_error(line: &[u8], ncols: usize, e: FieldError) -> FieldError {
+fn csv_error(line: &[u8], ncols: usize, trailing: bool, e: FieldError) -> FieldError {
     let found = count_csv_fields(line);
-    if found != ncols {
+    if wrong_count(found, ncols, trailing) {
         return FieldError::Columns { found };
     }
     match e {
@@ -549,8 +589,39 @@ fn csv_error(line: &[u8], ncols: usize, e: FieldError) -> FieldError {
     }
 }
 
+/// An integer with an optional sign that fits an `i64` (time stamps in ticks).
+fn parse_integer(field: &[u8]) -> Option<i64> {
+    let (negative, digits) = match field.first() {
+        Some(b'-') => (true, &field[1..]),
+        Some(b'+') => (false, &field[1..]),
+        _ => (false, field),
+    };
+    if digits.is_empty() || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let n = digits.iter().try_fold(0i64, |n, &d| {
+        n.checked_mul(10)?.checked_add(i64::from(d - b'0'))
+    })?;
+    Some(if negative { -n } else { n })
+}
+
+/// The time [s] of a stamp `value` written as `field` in `unit`, plus `offset` [s].
+/// Integer ticks are split into whole seconds and a fraction, the offset added to the
+/// whole seconds first, so nanoseconds since 1970 keep their resolution.
+fn stamp_seconds(field: &[u8], value: f64, unit: TimeUnit, offset: f64) -> f64 {
+    if unit == TimeUnit::S {
+        return if offset == 0.0 { value } else { value + offset };
+    }
+    let k = unit.ticks_per_second();
+    match parse_integer(field) {
+        // Both parts are exact in f64 (|n / k| < 2^53); the fraction rounds once.
+        Some(n) => (n.div_euclid(k) as f64 + offset) + n.rem_euclid(k) as f64 / k as f64,
+        None => value / k as f64 + offset,
+    }
+}
+
 /// Median of `values` (sorted in place); `None` if empty.
-fn median(values: &mut [f64]) -> Option<f64> {
+pub(super) fn median(values: &mut [f64]) -> Option<f64> {
     if values.is_empty() {
         return None;
     }
@@ -563,7 +634,8 @@ fn median(values: &mut [f64]) -> Option<f64> {
     })
 }
 
-/// A lazy, constant-memory reader of an IMU log, yielding increments.
+/// A lazy, constant-memory reader of an IMU log, yielding increments in the vehicle's
+/// FRD axes.
 ///
 /// Iterating yields `Ok(sample)` per data line in the time window, or one `Err` and
 /// then nothing.
@@ -573,6 +645,14 @@ pub struct ImuReader<R> {
     format: ImuFormat,
     columns: Columns,
     layout: ImuLayout,
+    /// How the columns are read (for the plausibility check).
+    plan: Plan,
+    /// The columns' units to SI: gyro, accelerometer.
+    to_si: (f64, f64),
+    /// The time column's unit and the offset added [s].
+    clock: (TimeUnit, f64),
+    /// IMU axes to vehicle FRD.
+    c_vs: Option<Matrix3<f64>>,
     nominal_dt: f64,
     t_start: Option<f64>,
     t_end: Option<f64>,
@@ -616,7 +696,7 @@ impl ImuReader<BufReader<File>> {
 impl<R: BufRead> ImuReader<R> {
     /// Wraps `input` (named `path` in errors, e.g. `<stdin>`), reads the CSV header if
     /// any and the first up to [`LOOKAHEAD_INTERVALS`] + 1 samples, fixes the nominal
-    /// interval and runs the layout check.
+    /// interval and runs the plausibility check.
     ///
     /// For standard input, wrap it in a [`BufReader`] of [`READ_BUFFER_BYTES`] for speed.
     pub fn new(
@@ -630,8 +710,12 @@ impl<R: BufRead> ImuReader<R> {
             lines: LineReader::new(input),
             path,
             format: options.format,
-            columns: Columns::Text,
-            layout: options.layout.unwrap_or(ImuLayout::Increments),
+            columns: Columns::kf_gins(ImuLayout::Increments),
+            layout: ImuLayout::Increments,
+            plan: Plan::kf_gins(ImuLayout::Increments),
+            to_si: (1.0, 1.0),
+            clock: (TimeUnit::S, options.time_offset),
+            c_vs: options.c_vs,
             nominal_dt: f64::NAN,
             t_start: options.t_start,
             t_end: options.t_end,
@@ -644,37 +728,7 @@ impl<R: BufRead> ImuReader<R> {
             gaps: GapReport::default(),
             finished: false,
         };
-        // First content line: decides the format, and is the CSV header.
-        let mut first_is_data = false;
-        loop {
-            if !reader.next_line()? {
-                return Err(reader.error(InputErrorKind::NoData, 0, None, "holds no IMU samples"));
-            }
-            let line = reader.lines.line();
-            if is_skippable(line) {
-                continue;
-            }
-            if reader.format == ImuFormat::Auto {
-                let start = skip_blanks(line, 0);
-                // A non-finite number is still a number: a text file, with a bad line 1.
-                let not_a_number = matches!(
-                    parse_number(line, start, 0),
-                    Err(FieldError::NotANumber { .. })
-                );
-                reader.format = if not_a_number {
-                    reader.csv_auto_detected = true;
-                    ImuFormat::Csv
-                } else {
-                    ImuFormat::KfGinsText
-                };
-            }
-            if reader.format == ImuFormat::Csv {
-                reader.read_header(options.layout)?;
-            } else {
-                first_is_data = true;
-            }
-            break;
-        }
+        let first_is_data = reader.read_first_line(options)?;
         if first_is_data {
             let record = reader.parse_current(false)?;
             reader.lookahead.push_back(record);
@@ -691,6 +745,94 @@ impl<R: BufRead> ImuReader<R> {
         }
         reader.gaps.threshold_s = GAP_FACTOR * reader.nominal_dt;
         Ok(reader)
+    }
+
+    /// Reads up to the first content line, decides the format and the columns (reading
+    /// a CSV header, or skipping it for [`ImuReadOptions::columns`]); whether that line
+    /// is data.
+    fn read_first_line(&mut self, options: &ImuReadOptions) -> Result<bool, InputError> {
+        loop {
+            if !self.next_line()? {
+                return Err(self.error(InputErrorKind::NoData, 0, None, "holds no IMU samples"));
+            }
+            if !is_skippable(self.lines.line()) {
+                break;
+            }
+        }
+        if self.format == ImuFormat::Auto {
+            let line = self.lines.line();
+            let start = skip_blanks(line, 0);
+            // A non-finite number is still a number: a text file, with a bad line 1.
+            let not_a_number = matches!(
+                parse_number(line, start, 0),
+                Err(FieldError::NotANumber { .. })
+            );
+            self.format = if not_a_number {
+                self.csv_auto_detected = true;
+                ImuFormat::Csv
+            } else {
+                ImuFormat::KfGinsText
+            };
+        }
+        let csv = self.format == ImuFormat::Csv;
+        let declared = options.declared();
+        let (plan, names, trailing) = match (&options.columns, csv) {
+            (Some(spec), _) => {
+                let names = spec.names().to_vec();
+                // Whatever is wrong is in the options, not in the file.
+                let plan = plan(&names, spec.columns(), &declared, "--imu-columns").map_err(|e| {
+                    PlanError {
+                        in_header: false,
+                        ..e
+                    }
+                });
+                (plan, names, spec.trailing())
+            }
+            (None, true) => {
+                let names = header_names(self.lines.line());
+                let cols = names
+                    .iter()
+                    .map(|n| recognise(n))
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(|m| self.plan_error(PlanError::header(None, m)))?;
+                let plan = plan(&names, &cols, &declared, "the header");
+                (plan, names, false)
+            }
+            (None, false) => {
+                let plan = default_plan(&declared);
+                let names = Vec::new();
+                (plan, names, false)
+            }
+        };
+        let plan = plan.map_err(|e| self.plan_error(e))?;
+        self.apply_plan(&plan, options, csv, names, trailing);
+        Ok(!csv)
+    }
+
+    /// Takes `plan` with the columns' `names` (empty: KF-GINS's).
+    fn apply_plan(
+        &mut self,
+        plan: &Plan,
+        options: &ImuReadOptions,
+        csv: bool,
+        names: Vec<String>,
+        trailing: bool,
+    ) {
+        self.layout = plan.layout;
+        self.to_si = (plan.gyro.to_si(), plan.accel.to_si());
+        self.clock = (plan.time, options.time_offset);
+        self.columns = if names.is_empty() {
+            Columns::kf_gins(plan.layout)
+        } else {
+            Columns {
+                csv,
+                slot_of_col: plan.slot_of_col.clone(),
+                names,
+                time_col: plan.time_col,
+                trailing,
+            }
+        };
+        self.plan = plan.clone();
     }
 
     /// The format read (never [`ImuFormat::Auto`]).
@@ -733,6 +875,25 @@ impl<R: BufRead> ImuReader<R> {
         InputError::new(kind, &self.path, line, field, message)
     }
 
+    /// The error of a plan: at the header's line if the header is at fault, else of
+    /// the options (line 0).
+    fn plan_error(&self, e: PlanError) -> InputError {
+        if !e.in_header {
+            return self.error(InputErrorKind::Usage, 0, e.field.as_deref(), e.message);
+        }
+        let detected = if self.csv_auto_detected && e.message.contains("lacks") {
+            "; this line was taken for a CSV header because its first field is not a number"
+        } else {
+            ""
+        };
+        self.error(
+            InputErrorKind::Header,
+            self.lines.line_no(),
+            e.field.as_deref(),
+            format!("{}{detected}", e.message),
+        )
+    }
+
     /// Advances to the next line; `Ok(false)` at the end.
     fn next_line(&mut self) -> Result<bool, InputError> {
         match self.lines.next_line() {
@@ -752,124 +913,31 @@ impl<R: BufRead> ImuReader<R> {
         }
     }
 
-    /// Parses the current line as the CSV header.
-    fn read_header(&mut self, layout: Option<ImuLayout>) -> Result<(), InputError> {
-        let line_no = self.lines.line_no();
-        let names = header_names(self.lines.line());
-        let (chosen, set, missing) = choose_layout(&names, layout);
-        if !missing.is_empty() {
-            return Err(self.missing_columns(line_no, chosen, &missing, layout.is_none()));
-        }
-        let (slot_of_col, time_col) = self.slots(line_no, &names, set)?;
-        self.layout = chosen;
-        self.columns = Columns::Csv {
-            slot_of_col,
-            names,
-            time_col,
-        };
-        Ok(())
-    }
-
-    /// The error of a header at `line_no` that lacks the columns `missing` of the
-    /// layout `chosen` (`guessed`: the layout was not given, so both sets are named).
-    fn missing_columns(
-        &self,
-        line_no: u64,
-        chosen: ImuLayout,
-        missing: &[&str],
-        guessed: bool,
-    ) -> InputError {
-        let detected = if self.csv_auto_detected {
-            "; this line was taken for a CSV header because its first field is not a number"
-        } else {
-            ""
-        };
-        let also = if guessed {
-            " (a CSV IMU log needs t (or time) and either dtheta_x, dtheta_y, dtheta_z, \
-             dvel_x, dvel_y, dvel_z or w_x, w_y, w_z, f_x, f_y, f_z)"
-        } else {
-            ""
-        };
-        self.error(
-            InputErrorKind::Header,
-            line_no,
-            None,
-            format!(
-                "header lacks column(s) {} for {chosen}{also}{detected}",
-                missing.join(", ")
-            ),
-        )
-    }
-
-    /// For each column of the header `names` (line `line_no`), the slot of `set` it
-    /// holds ([`UNUSED`] for none), and the time's column; every name of `set` must
-    /// appear exactly once.
-    fn slots(
-        &self,
-        line_no: u64,
-        names: &[String],
-        set: &[&str; 7],
-    ) -> Result<(Vec<u8>, usize), InputError> {
-        let mut slot_of_col = vec![UNUSED; names.len()];
-        let mut time_col = 0;
-        for (slot, name) in set.iter().enumerate() {
-            let found = columns_named(names, name);
-            if let [first, second, ..] = found[..] {
-                return Err(self.error(
-                    InputErrorKind::Header,
-                    line_no,
-                    Some(&names[first]),
-                    format!(
-                        "column appears twice (columns {} and {})",
-                        first + 1,
-                        second + 1
-                    ),
-                ));
-            }
-            // The caller checked that no name is missing, so it was found exactly once.
-            let col = found[0];
-            if slot == 0 {
-                time_col = col;
-            }
-            // `slot` < 7 fits a u8.
-            slot_of_col[col] = slot as u8;
-        }
-        Ok((slot_of_col, time_col))
-    }
-
     /// Name of column `col` (0-based) for messages.
     fn column_name(&self, col: usize) -> &str {
-        match &self.columns {
-            Columns::Text => match self.layout {
-                ImuLayout::Increments => INCREMENT_NAMES[col],
-                ImuLayout::Rates => RATE_NAMES[col],
-            },
-            Columns::Csv { names, .. } => &names[col],
-        }
+        &self.columns.names[col]
     }
 
     /// Name of the time column.
     fn time_name(&self) -> &str {
-        match &self.columns {
-            Columns::Text => "t",
-            Columns::Csv { time_col, .. } => self.column_name(*time_col),
-        }
+        self.column_name(self.columns.time_col)
     }
 
     #[cold]
     fn field_error(&self, e: FieldError) -> InputError {
         let line_no = self.lines.line_no();
         let line = self.lines.line();
-        let expected = match &self.columns {
-            Columns::Text => TEXT_COLUMNS,
-            Columns::Csv { slot_of_col, .. } => slot_of_col.len(),
-        };
+        let expected = self.columns.slot_of_col.len();
         match e {
             FieldError::Columns { found } => self.error(
                 InputErrorKind::ColumnCount,
                 line_no,
                 None,
-                format!("expected {expected} columns, found {found}"),
+                if self.columns.trailing {
+                    format!("expected at least {expected} columns, found {found}")
+                } else {
+                    format!("expected {expected} columns, found {found}")
+                },
             ),
             FieldError::Empty { col } => self.error(
                 InputErrorKind::NotANumber,
@@ -892,38 +960,49 @@ impl<R: BufRead> ImuReader<R> {
         }
     }
 
+    /// Parses the current line's time (`time_only`) or all its columns into `out`;
+    /// returns the time on the reader's clock.
+    #[inline]
+    fn parse_fields(&self, time_only: bool, out: &mut [f64; 7]) -> Result<f64, FieldError> {
+        let line = self.lines.line();
+        let c = &self.columns;
+        let mut span = (0, 0);
+        if c.csv {
+            parse_csv_line(
+                line,
+                &c.slot_of_col,
+                (time_only, c.trailing),
+                out,
+                &mut span,
+            )?;
+        } else {
+            let ncols = if time_only {
+                c.time_col + 1
+            } else {
+                c.slot_of_col.len()
+            };
+            parse_text_line(line, &c.slot_of_col, ncols, c.trailing, out, &mut span)?;
+        }
+        let (unit, offset) = self.clock;
+        Ok(stamp_seconds(&line[span.0..span.1], out[0], unit, offset))
+    }
+
     /// Parses the current line (a data line) into a record and checks its time
     /// against the previous one. With `time_only`, only the time is parsed unless
     /// it reaches `t_start`.
     #[inline]
     fn parse_current(&mut self, time_only: bool) -> Result<Record, InputError> {
         let mut out = [0.0; 7];
-        let line = self.lines.line();
-        let parsed = match &self.columns {
-            Columns::Text => {
-                let first =
-                    parse_text_line(line, if time_only { 1 } else { TEXT_COLUMNS }, &mut out);
-                match (first, time_only) {
-                    (Ok(()), true) if self.t_start.is_some_and(|s| out[0] >= s) => {
-                        parse_text_line(line, TEXT_COLUMNS, &mut out)
-                    }
-                    (r, _) => r,
-                }
+        let parsed = match self.parse_fields(time_only, &mut out) {
+            Ok(t) if time_only && self.t_start.is_some_and(|s| t >= s) => {
+                self.parse_fields(false, &mut out)
             }
-            Columns::Csv { slot_of_col, .. } => {
-                let first = parse_csv_line(line, slot_of_col, time_only, &mut out);
-                match (first, time_only) {
-                    (Ok(()), true) if self.t_start.is_some_and(|s| out[0] >= s) => {
-                        parse_csv_line(line, slot_of_col, false, &mut out)
-                    }
-                    (r, _) => r,
-                }
-            }
+            other => other,
         };
-        if let Err(e) = parsed {
-            return Err(self.field_error(e));
-        }
-        let t = out[0];
+        let t = match parsed {
+            Ok(t) => t,
+            Err(e) => return Err(self.field_error(e)),
+        };
         let line_no = self.lines.line_no();
         if let Some((t_prev, line_prev)) = self.last
             && t <= t_prev
@@ -994,61 +1073,66 @@ impl<R: BufRead> ImuReader<R> {
         }
     }
 
-    /// Rejects a log whose accelerometer columns look like the other layout.
-    ///
-    /// Over the lookahead (sample i with interval `dt_i`, accelerometer columns `a_i`),
-    /// the median `|a_i| / dt_i` is the specific force if the columns are increments,
-    /// the median `|a_i|` if they are rates. Declared increments fail when the first is
-    /// above [`IMPLAUSIBLY_HIGH_G`] and the second within [`PLAUSIBLE_SPECIFIC_FORCE_G`];
-    /// declared rates fail when the second is below [`IMPLAUSIBLY_LOW_G`] and the first
-    /// plausible. Needs [`LAYOUT_CHECK_MIN_INTERVALS`].
+    /// Rejects a log whose first samples no sensor on the Earth reads, naming the check
+    /// and the flags that probably read it right ([`super::imu_plausibility`]). Needs
+    /// [`LAYOUT_CHECK_MIN_INTERVALS`].
     fn check_layout(&self) -> Result<(), InputError> {
-        let n = self.lookahead.len().saturating_sub(1);
-        if n < LAYOUT_CHECK_MIN_INTERVALS {
+        if self.lookahead.len() <= LAYOUT_CHECK_MIN_INTERVALS {
             return Ok(());
         }
-        let mut as_increments = Vec::with_capacity(n);
-        let mut as_rates = Vec::with_capacity(n);
-        for (a, b) in self.lookahead.iter().zip(self.lookahead.iter().skip(1)) {
-            let norm = Vector3::new(b.v[3], b.v[4], b.v[5]).norm();
-            as_increments.push(norm / (b.t - a.t) / STANDARD_GRAVITY);
-            as_rates.push(norm / STANDARD_GRAVITY);
-        }
-        let (Some(g_inc), Some(g_rate)) = (median(&mut as_increments), median(&mut as_rates))
+        let ticks = self.clock.0.ticks_per_second() as f64;
+        let readings: Vec<Reading> = self
+            .lookahead
+            .iter()
+            .zip(self.lookahead.iter().skip(1))
+            .map(|(a, b)| Reading {
+                // In the declared unit (× 1 for seconds): the check tries others.
+                dt: (b.t - a.t) * ticks,
+                gyro: Vector3::new(b.v[0], b.v[1], b.v[2]),
+                accel: Vector3::new(b.v[3], b.v[4], b.v[5]),
+            })
+            .collect();
+        let Err(finding) =
+            super::imu_plausibility::check(&readings, &self.plan, self.columns.trailing)
         else {
             return Ok(());
         };
-        let plausible =
-            |g: f64| (PLAUSIBLE_SPECIFIC_FORCE_G.0..=PLAUSIBLE_SPECIFIC_FORCE_G.1).contains(&g);
-        let (looks_like, field, declared_g, other_g) = match self.layout {
-            ImuLayout::Increments if g_inc > IMPLAUSIBLY_HIGH_G && plausible(g_rate) => {
-                (ImuLayout::Rates, "dvel", g_inc, g_rate)
-            }
-            ImuLayout::Rates if g_rate < IMPLAUSIBLY_LOW_G && plausible(g_inc) => {
-                (ImuLayout::Increments, "f", g_rate, g_inc)
-            }
-            _ => return Ok(()),
-        };
         let first_line = self.first_data_line;
         let last_line = self.last.map_or(first_line, |(_, line)| line);
-        let declared = self.layout;
-        let field = match &self.columns {
-            Columns::Text => format!("{field} (columns 5-7)"),
-            Columns::Csv { .. } => format!("{field}_x, {field}_y, {field}_z"),
-        };
         Err(self.error(
             InputErrorKind::LayoutMismatch,
             first_line,
-            Some(&field),
-            format!(
-                "lines {first_line}-{last_line} look like {looks_like}, not {declared}: read as \
-                 {declared} their median specific force is {declared_g:.3} g, read as \
-                 {looks_like} {other_g:.3} g (g = {STANDARD_GRAVITY} m/s^2; plausible \
-                 {}-{} g); read the file as {looks_like} (--imu-layout {looks_like}) or \
-                 turn this check off (--no-layout-check)",
-                PLAUSIBLE_SPECIFIC_FORCE_G.0, PLAUSIBLE_SPECIFIC_FORCE_G.1
-            ),
+            Some(&self.sensor_field(finding.sensor)),
+            format!("lines {first_line}-{last_line} {}", finding.message),
         ))
+    }
+
+    /// The columns of a sensor, for messages: `dvel (columns 5-7)` in text, the names in
+    /// CSV.
+    fn sensor_field(&self, sensor: Sensor) -> String {
+        let (slots, prefix) = match (sensor, self.layout) {
+            (Sensor::Time, _) => return self.time_name().to_owned(),
+            (Sensor::Gyro, ImuLayout::Increments) => (1..=3, "dtheta"),
+            (Sensor::Gyro, ImuLayout::Rates) => (1..=3, "w"),
+            (Sensor::Accel, ImuLayout::Increments) => (4..=6, "dvel"),
+            (Sensor::Accel, ImuLayout::Rates) => (4..=6, "f"),
+        };
+        let cols: Vec<usize> = (0..self.columns.slot_of_col.len())
+            .filter(|&i| slots.contains(&self.columns.slot_of_col[i]))
+            .collect();
+        if self.columns.csv {
+            let names: Vec<&str> = cols.iter().map(|&i| self.column_name(i)).collect();
+            return names.join(", ");
+        }
+        match cols[..] {
+            [a, b, c] if b == a + 1 && c == a + 2 => {
+                format!("{prefix} (columns {}-{})", a + 1, c + 1)
+            }
+            _ => {
+                let numbers: Vec<String> = cols.iter().map(|i| (i + 1).to_string()).collect();
+                format!("{prefix} (columns {})", numbers.join(", "))
+            }
+        }
     }
 }
 
@@ -1071,17 +1155,26 @@ fn check_options(path: &Path, o: &ImuReadOptions) -> Result<(), InputError> {
             format!("nominal sample interval must be > 0 s, got {dt}"),
         );
     }
-    for (name, t) in [("t_start", o.t_start), ("t_end", o.t_end)] {
+    for (name, t) in [
+        ("t_start", o.t_start),
+        ("t_end", o.t_end),
+        ("time_offset", Some(o.time_offset)),
+    ] {
         if let Some(t) = t
             && !t.is_finite()
         {
-            return bad(name, format!("window bound must be finite, got {t}"));
+            return bad(name, format!("must be finite, got {t}"));
         }
     }
     if let (Some(s), Some(e)) = (o.t_start, o.t_end)
         && s > e
     {
         return bad("t_start", format!("window start {s} is after its end {e}"));
+    }
+    if let Some(c) = &o.c_vs
+        && !((c.transpose() * c - Matrix3::identity()).amax() < 1e-9 && c.determinant() > 0.0)
+    {
+        return bad("c_vs", format!("not a rotation: {c}"));
     }
     Ok(())
 }
@@ -1128,16 +1221,21 @@ impl<R: BufRead> Iterator for ImuReader<R> {
             if had_prev && dt > self.gaps.threshold_s {
                 self.gaps.record(t, dt);
             }
-            let scale = match self.layout {
+            // SI factors times dt for rates; exactly 1 for SI increments.
+            let per = match self.layout {
                 ImuLayout::Increments => 1.0,
                 ImuLayout::Rates => dt,
             };
             let v = record.v;
-            return Some(Ok(ImuSample {
+            let sample = ImuSample {
                 t,
                 dt,
-                dtheta: Vector3::new(v[0], v[1], v[2]) * scale,
-                dvel: Vector3::new(v[3], v[4], v[5]) * scale,
+                dtheta: Vector3::new(v[0], v[1], v[2]) * (self.to_si.0 * per),
+                dvel: Vector3::new(v[3], v[4], v[5]) * (self.to_si.1 * per),
+            };
+            return Some(Ok(match &self.c_vs {
+                Some(c_vs) => sample.rotated(c_vs),
+                None => sample,
             }));
         }
     }
@@ -1687,6 +1785,183 @@ mod tests {
         let s = read_all(&input, &window).expect("junk before the window is not parsed");
         assert_eq!(s.len(), 80);
         assert_eq!(s[0].t, 1.6);
+    }
+
+    /// A device's text file: accelerometer first in g, gyro in deg/s, a counter to
+    /// skip, integer nanoseconds from 0 put on GPS time, and a last column ignored.
+    #[test]
+    fn text_in_another_order_with_units_and_clock() {
+        let input = "7,0,0.5,-0.25,-1.0,10.0,-20.0,30.0,x\n\
+                     8,5000000,0.5,-0.25,-1.0,10.0,-20.0,30.0,y\n\
+                     9,10000000,0.5,-0.25,-1.0,10.0,-20.0,30.0,z\n";
+        let options = ImuReadOptions {
+            columns: Some(ColumnSpec::parse("_,t,fx,fy,fz,wx,wy,wz,...").expect("spec")),
+            gyro_unit: Some(GyroUnit::DegPerSecond),
+            accel_unit: Some(AccelUnit::G),
+            time_unit: Some(TimeUnit::Ns),
+            time_offset: 345600.0,
+            check_layout: false,
+            ..ImuReadOptions::default()
+        };
+        let r = reader(input, &options).expect("good");
+        assert_eq!(
+            (r.format(), r.layout()),
+            (ImuFormat::KfGinsText, ImuLayout::Rates)
+        );
+        let s: Vec<_> = r.collect::<Result<_, _>>().expect("good");
+        assert_eq!(s[1].t, 345600.005);
+        assert_eq!(s[1].dt, 345600.005 - 345600.0);
+        let dt = s[1].dt;
+        let deg = std::f64::consts::PI / 180.0;
+        assert_eq!(s[1].dtheta, Vector3::new(10.0, -20.0, 30.0) * (deg * dt));
+        assert_eq!(
+            s[1].dvel,
+            Vector3::new(0.5, -0.25, -1.0) * (STANDARD_GRAVITY * dt)
+        );
+        // Errors name the spec's columns, and a short line is "at least".
+        let bad = input.replace("8,5000000,0.5", "8,5000000,0.5x");
+        assert_err(
+            &read_err(&bad, &options),
+            2,
+            Some("fx"),
+            InputErrorKind::NotANumber,
+            "\"0.5x\"",
+        );
+        let short = input.replace(",y", "").replace(",30.0\n9", "\n9");
+        assert_err(
+            &read_err(&short, &options),
+            2,
+            None,
+            InputErrorKind::ColumnCount,
+            "expected at least 8 columns, found 7",
+        );
+    }
+
+    /// A unit `--imu-columns` leaves open is the options' fault, not the file's.
+    #[test]
+    fn an_ambiguous_spec_is_a_usage_error() {
+        let ambiguous = ImuReadOptions {
+            columns: Some(ColumnSpec::parse("t,gx_deg,gy_deg,gz_deg,ax,ay,az").expect("spec")),
+            ..text()
+        };
+        let e = read_err("1 0 0 0 0 0 0\n", &ambiguous);
+        assert_err(
+            &e,
+            0,
+            Some("gx_deg"),
+            InputErrorKind::Usage,
+            "give --gyro-unit deg or --gyro-unit deg/s",
+        );
+    }
+
+    /// Nanoseconds since 1970 (19 digits, beyond f64's 2^53) keep their resolution
+    /// when an offset brings them near zero.
+    #[test]
+    fn integer_stamps_are_exact() {
+        assert_eq!(
+            stamp_seconds(b"1730147509121814120", 1.73e18, TimeUnit::Ns, -1730147509.0),
+            0.12181412
+        );
+        assert_eq!(stamp_seconds(b"-1500", -1500.0, TimeUnit::Ms, 0.0), -1.5);
+        assert_eq!(stamp_seconds(b"12.5", 12.5, TimeUnit::Ms, 1.0), 1.0125);
+        assert_eq!(stamp_seconds(b"12.5", 12.5, TimeUnit::S, 0.0), 12.5);
+        assert_eq!(parse_integer(b"+12"), Some(12));
+        assert_eq!(parse_integer(b"1e3"), None);
+        assert_eq!(
+            parse_integer(b"1234567890123456789"),
+            Some(1234567890123456789)
+        );
+        assert_eq!(parse_integer(b"12345678901234567890"), None);
+    }
+
+    /// A CSV header of common names with units, in another order, and the header of a
+    /// device the reader does not know, replaced by `--imu-columns`.
+    #[test]
+    fn csv_common_names_and_replaced_headers() {
+        let input = "timestamp_ns,ax_g,ay_g,az_g,gx_dps,gy_dps,gz_dps,temp\n\
+                     1000000000,0,0,-1,0,0,90,20\n\
+                     1010000000,0,0,-1,0,0,90,20\n";
+        let r = reader(input, &ImuReadOptions::default()).expect("recognised");
+        assert_eq!(r.layout(), ImuLayout::Rates);
+        let s: Vec<_> = r.collect::<Result<_, _>>().expect("good");
+        assert_eq!(s[1].t, 1.01);
+        assert!((s[1].dtheta.z - 90f64.to_radians() * s[1].dt).abs() < 1e-15);
+        assert_eq!(s[1].dvel.z, -STANDARD_GRAVITY * s[1].dt);
+        let unknown = "state,stamp,scaledAccelX,scaledAccelY,scaledAccelZ,scaledGyroX,scaledGyroY,scaledGyroZ\n\
+                       S,1000000000,0,0,-1,0,0,0.1\n\
+                       S,1010000000,0,0,-1,0,0,0.1\n";
+        let e = read_err(unknown, &ImuReadOptions::default());
+        assert_err(
+            &e,
+            1,
+            None,
+            InputErrorKind::Header,
+            "recognised: time t, time, timestamp",
+        );
+        assert!(e.message.contains("--imu-columns"), "{e}");
+        let named = ImuReadOptions {
+            columns: Some(ColumnSpec::parse("_,t,fx,fy,fz,wx,wy,wz").expect("spec")),
+            accel_unit: Some(AccelUnit::G),
+            time_unit: Some(TimeUnit::Ns),
+            ..ImuReadOptions::default()
+        };
+        let s = read_all(unknown, &named).expect("header skipped");
+        assert_eq!((s.len(), s[1].t), (2, 1.01));
+        assert_eq!(s[1].dtheta.z, 0.1 * s[1].dt);
+        // Options that contradict each other or the header.
+        let contradiction = ImuReadOptions {
+            gyro_unit: Some(GyroUnit::Rad),
+            ..ImuReadOptions::default()
+        };
+        let e = read_err(input, &contradiction);
+        assert_err(
+            &e,
+            0,
+            Some("imu_layout"),
+            InputErrorKind::Usage,
+            "the names of the header say rates, --gyro-unit rad says increments",
+        );
+        let e = read_err(
+            "1 0 0 0 0 0 0\n",
+            &ImuReadOptions {
+                layout: Some(ImuLayout::Increments),
+                ..contradiction.clone()
+            },
+        );
+        assert_eq!(e.kind, InputErrorKind::Usage);
+        let e = read_err(
+            input,
+            &ImuReadOptions {
+                accel_unit: Some(AccelUnit::MetrePerSecond2),
+                ..ImuReadOptions::default()
+            },
+        );
+        assert_err(
+            &e,
+            0,
+            Some("accel_unit"),
+            InputErrorKind::Usage,
+            "contradicts the column \"ax_g\" of the header",
+        );
+    }
+
+    /// An IMU mounted RBD: its samples come out in the vehicle's FRD axes.
+    #[test]
+    fn axes_turn_every_sample() {
+        let rbd: schuler::imu::axes::SensorAxes = "RBD".parse().expect("right-handed");
+        let input = "1 0.1 0.2 0.3 0.4 0.5 0.6\n2 0.1 0.2 0.3 0.4 0.5 0.6\n";
+        let options = ImuReadOptions {
+            c_vs: Some(rbd.c_vs()),
+            ..text()
+        };
+        let s = read_all(input, &options).expect("good");
+        assert_eq!(s[1].dtheta, Vector3::new(-0.2, 0.1, 0.3));
+        assert_eq!(s[1].dvel, Vector3::new(-0.5, 0.4, 0.6));
+        let mirror = ImuReadOptions {
+            c_vs: Some(Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0))),
+            ..text()
+        };
+        assert_eq!(read_err(input, &mirror).field.as_deref(), Some("c_vs"));
     }
 
     #[test]

@@ -8,7 +8,9 @@
 pub mod error;
 pub mod gnss;
 mod gps_time;
+pub mod imu_columns;
 pub mod imu_log;
+pub mod imu_plausibility;
 mod lines;
 pub mod nav;
 pub mod nmea;

@@ -67,8 +67,19 @@ pub fn simulate(config: &Path, dir: &Path) -> PathBuf {
 /// `schuler nav --gnss` of the simulated drive into `out` (its initial state, lever
 /// arm and IMU grade, 10-Hz output), with `extra` flags.
 pub fn nav_drive(sim: &Path, out: &Path, extra: &[&std::ffi::OsStr]) -> assert_cmd::assert::Assert {
+    nav_drive_imu(sim, &sim.join("imu.txt"), out, extra)
+}
+
+/// [`nav_drive`] on another IMU file than the simulated one (the same drive written
+/// otherwise).
+pub fn nav_drive_imu(
+    sim: &Path,
+    imu: &Path,
+    out: &Path,
+    extra: &[&std::ffi::OsStr],
+) -> assert_cmd::assert::Assert {
     let gnss = sim.join("gnss.txt");
-    nav_drive_gnss(sim, out, &["--gnss".as_ref(), gnss.as_os_str()], extra)
+    nav_drive_with(imu, &["--gnss".as_ref(), gnss.as_os_str()], out, extra)
 }
 
 /// [`nav_drive`] with the GNSS flags `gnss` in place of `--gnss sim/gnss.txt`.
@@ -78,10 +89,21 @@ pub fn nav_drive_gnss(
     gnss: &[&std::ffi::OsStr],
     extra: &[&std::ffi::OsStr],
 ) -> assert_cmd::assert::Assert {
+    nav_drive_with(&sim.join("imu.txt"), gnss, out, extra)
+}
+
+/// `schuler nav` of the drive's IMU log `imu` with the GNSS flags `gnss` (the drive's
+/// initial state, lever arm and IMU grade, 10-Hz output) into `out`, with `extra`.
+fn nav_drive_with(
+    imu: &Path,
+    gnss: &[&std::ffi::OsStr],
+    out: &Path,
+    extra: &[&std::ffi::OsStr],
+) -> assert_cmd::assert::Assert {
     assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .args(["nav", "--imu"])
-        .arg(sim.join("imu.txt"))
+        .arg(imu)
         .args(gnss)
         .args(["--init-pos", "45.07,7.68,245", "--init-att", "0,0,10"])
         .args([

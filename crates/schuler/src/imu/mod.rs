@@ -5,10 +5,11 @@
 //! integrated over the interval `(t - dt, t]`, in body axes front-right-down (FRD).
 //!
 //! Beside them, what describes a sensor rather than simulates one: the IMU error
-//! model's parameters ([`model`]) and the seeded random stream ([`random`]) that every
-//! random draw of the crate comes from, so that `nav`, `filter` and `align` need not
-//! import `sim`.
+//! model's parameters ([`model`]), where its axes point on the vehicle ([`axes`]), and
+//! the seeded random stream ([`random`]) that every random draw of the crate comes
+//! from, so that `nav`, `filter` and `align` need not import `sim`.
 
+pub mod axes;
 pub mod model;
 pub mod random;
 
@@ -36,6 +37,16 @@ impl ImuSample {
             dt,
             dtheta: w_ib_b * dt,
             dvel: f_b * dt,
+        }
+    }
+
+    /// The same sample in other axes: `c_vs` maps the sample's axes to the new ones
+    /// (e.g. [`axes::SensorAxes::c_vs`], sensor to vehicle FRD).
+    pub fn rotated(&self, c_vs: &Matrix3<f64>) -> Self {
+        Self {
+            dtheta: c_vs * self.dtheta,
+            dvel: c_vs * self.dvel,
+            ..*self
         }
     }
 
@@ -223,6 +234,17 @@ mod tests {
         let mut e = SensorErrors::default();
         e.gyro.bias.x = f64::NAN;
         assert_eq!(Compensation::new(&e), Err(ImuError::NonFinite("gyro")));
+    }
+
+    #[test]
+    fn rotated_turns_both_increments() {
+        let c = axes::SensorAxes::FRD.c_vs();
+        assert_eq!(sample().rotated(&c), sample());
+        let rbd: axes::SensorAxes = "RBD".parse().expect("right-handed");
+        let s = sample().rotated(&rbd.c_vs());
+        assert_eq!(s.dtheta, Vector3::new(2e-4, 1e-3, 5e-5));
+        assert_eq!(s.dvel, Vector3::new(-0.002, 0.01, -0.049));
+        assert_eq!((s.t, s.dt), (10.0, 0.005));
     }
 
     #[test]
