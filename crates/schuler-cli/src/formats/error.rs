@@ -23,8 +23,9 @@ pub enum InputErrorKind {
     NoData,
     /// A line is longer than the reader's bound (see the reader's docs).
     LineTooLong,
-    /// The values look like another layout than the one read: rates where increments
-    /// are expected, or a GNSS position log given as a velocity log.
+    /// The values are not what the file was read as: IMU samples no sensor on the
+    /// Earth reads as declared (rates where increments are expected, units or columns
+    /// mistaken), or a GNSS position log given as a velocity log.
     LayoutMismatch,
     /// A reader option (nominal interval, time window) is invalid, or the file holds
     /// too little data to establish what the reader needs.

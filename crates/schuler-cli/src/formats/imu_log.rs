@@ -283,6 +283,8 @@ struct Columns {
     time_col: usize,
     /// Whether a line may hold further columns, ignored.
     trailing: bool,
+    /// Whether the columns are not KF-GINS's seven in slot order.
+    mapped: bool,
 }
 
 impl Columns {
@@ -298,6 +300,7 @@ impl Columns {
             names: names.iter().map(|&n| n.to_owned()).collect(),
             time_col: 0,
             trailing: false,
+            mapped: false,
         }
     }
 }
@@ -417,11 +420,11 @@ fn count_text_fields(line: &[u8]) -> usize {
 type Span = (usize, usize);
 
 /// Text format: parses the first `ncols` columns of `slots` (each column's slot, or
-/// [`UNUSED`] to skip it) into `out`, the time's span into `time`, and with `ncols ==
-/// slots.len()` and not `trailing` checks that nothing follows. A trailing separator is
-/// accepted.
+/// [`UNUSED`] to skip it; with `MAPPED` false column i is slot i, KF-GINS's fast path)
+/// into `out`, the time's span into `time`, and with `ncols == slots.len()` and not
+/// `trailing` checks that nothing follows. A trailing separator is accepted.
 #[inline]
-fn parse_text_line(
+fn parse_text_line<const MAPPED: bool>(
     line: &[u8],
     slots: &[u8],
     ncols: usize,
@@ -430,8 +433,10 @@ fn parse_text_line(
     time: &mut Span,
 ) -> Result<(), FieldError> {
     let mut pos = skip_blanks(line, 0);
-    for (col, &slot) in slots.iter().enumerate().take(ncols) {
-        if slot == UNUSED && pos < line.len() {
+    for col in 0..ncols.min(slots.len()) {
+        // `col` < 7 without a map: KF-GINS text has 7 slots.
+        let slot = if MAPPED { slots[col] } else { col as u8 };
+        if MAPPED && slot == UNUSED && pos < line.len() {
             let end = if line[pos] == b',' {
                 pos
             } else {
@@ -830,6 +835,7 @@ impl<R: BufRead> ImuReader<R> {
                 names,
                 time_col: plan.time_col,
                 trailing,
+                mapped: true,
             }
         };
         self.plan = plan.clone();
@@ -981,10 +987,16 @@ impl<R: BufRead> ImuReader<R> {
             } else {
                 c.slot_of_col.len()
             };
-            parse_text_line(line, &c.slot_of_col, ncols, c.trailing, out, &mut span)?;
+            if c.mapped {
+                parse_text_line::<true>(line, &c.slot_of_col, ncols, c.trailing, out, &mut span)?;
+            } else {
+                parse_text_line::<false>(line, &c.slot_of_col, ncols, false, out, &mut span)?;
+            }
         }
-        let (unit, offset) = self.clock;
-        Ok(stamp_seconds(&line[span.0..span.1], out[0], unit, offset))
+        match self.clock {
+            (TimeUnit::S, 0.0) => Ok(out[0]),
+            (unit, offset) => Ok(stamp_seconds(&line[span.0..span.1], out[0], unit, offset)),
+        }
     }
 
     /// Parses the current line (a data line) into a record and checks its time
