@@ -25,6 +25,21 @@ fn nav_from_fixes(dir: &std::path::Path, init: &str) -> (String, std::path::Path
     )
 }
 
+/// The largest heading error [deg] of the nav.txt rows `nav` against the truth rows
+/// from time `from` [s] on.
+fn worst_heading_error(nav: &[Vec<f64>], truth: &[Vec<f64>], from: f64) -> f64 {
+    let at = |t: f64| {
+        truth
+            .iter()
+            .find(|r| (r[1] - t).abs() < 1e-6)
+            .expect("truth at the epoch")
+    };
+    nav.iter()
+        .filter(|r| r[1] >= from)
+        .map(|r| ((r[10] - at(r[1])[10] + 540.0).rem_euclid(360.0) - 180.0).abs())
+        .fold(0.0f64, f64::max)
+}
+
 #[test]
 fn a_drive_started_in_motion_matches_the_truth() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -41,22 +56,9 @@ fn a_drive_started_in_motion_matches_the_truth() {
     let truth = common::read_rows(&sim.join("truth.nav"));
     let t0 = nav[0][1];
     assert!(t0 > 45.0 && t0 < 75.0, "started at {t0} s");
-    let at = |t: f64| {
-        truth
-            .iter()
-            .find(|r| (r[1] - t).abs() < 1e-6)
-            .expect("truth at the epoch")
-    };
-    // After a minute of motion from the drive-off at 60 s (turns included) the heading is within 1 deg of the
-    // truth to the end.
-    let worst = nav
-        .iter()
-        .filter(|r| r[1] >= 120.0)
-        .map(|r| {
-            let d = (r[10] - at(r[1])[10] + 540.0).rem_euclid(360.0) - 180.0;
-            d.abs()
-        })
-        .fold(0.0f64, f64::max);
+    // After a minute of motion from the drive-off at 60 s (turns included) the heading
+    // is within 1 deg of the truth to the end.
+    let worst = worst_heading_error(&nav, &truth, 120.0);
     eprintln!(
         "{stdout}started at {t0} s; largest heading error after 60 s of motion {worst:.3} deg"
     );
@@ -81,17 +83,7 @@ fn a_drive_started_with_any_heading_matches_the_truth() {
         .unwrap_or_else(|| panic!("{stdout}"));
     let nav = common::read_rows(&out.join("nav.txt"));
     let truth = common::read_rows(&sim.join("truth.nav"));
-    let at = |t: f64| {
-        truth
-            .iter()
-            .find(|r| (r[1] - t).abs() < 1e-6)
-            .expect("truth at the epoch")
-    };
-    let worst = nav
-        .iter()
-        .filter(|r| r[1] >= 180.0)
-        .map(|r| ((r[10] - at(r[1])[10] + 540.0).rem_euclid(360.0) - 180.0).abs())
-        .fold(0.0f64, f64::max);
+    let worst = worst_heading_error(&nav, &truth, 180.0);
     eprintln!("{stdout}{kept}; largest heading error from 180 s {worst:.3} deg");
     // The drive's heading is 10 deg: the member started at 0 deg is the nearest.
     assert!(kept.contains("started at 0 deg"), "{kept}");
