@@ -20,8 +20,9 @@
 //! their median; otherwise the curve measures the motion and a warning names the
 //! file.
 
-use crate::formats::{ImuReadOptions, ImuReader};
-use crate::options::{FormatChoice, LayoutChoice, quantity};
+use crate::formats::ImuReader;
+use crate::imu_input::ImuInputOptions;
+use crate::options::quantity;
 use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
@@ -44,12 +45,9 @@ pub struct Args {
     /// terms.
     #[arg(value_name = "IMU_FILE")]
     pub imu: PathBuf,
-    /// IMU file format.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub imu_format: FormatChoice,
-    /// Increments or rates in the IMU columns.
-    #[arg(long, value_enum)]
-    pub imu_layout: Option<LayoutChoice>,
+    /// How to read the log: format, columns, units, clock and axes, as `nav` reads it.
+    #[command(flatten)]
+    pub input: ImuInputOptions,
     /// Output directory for allan.csv, allan.svg and imu_noise.toml (default: the
     /// current directory).
     #[arg(long, value_name = "DIR")]
@@ -193,14 +191,7 @@ fn fit_channels(allan: &ImuAllan) -> Vec<ChannelFit> {
 
 /// Reads the samples of the log in the time window.
 fn read(args: &Args) -> Result<(Vec<ImuSample>, Option<String>)> {
-    let options = ImuReadOptions {
-        format: args.imu_format.format(),
-        layout: args.imu_layout.map(LayoutChoice::layout),
-        nominal_dt: None,
-        t_start: args.start,
-        t_end: args.end,
-        ..ImuReadOptions::default()
-    };
+    let options = args.input.read_options(args.start, args.end)?;
     let mut reader = ImuReader::open(&args.imu, &options)?;
     let samples = (&mut reader).collect::<Result<Vec<_>, _>>()?;
     let gaps = reader.gaps();

@@ -3,8 +3,8 @@
 //!
 //! # Formats
 //! - **KF-GINS text** (also the awesome-gins-datasets IMU files): one sample per line,
-//!   7 numbers separated by blanks (spaces or tabs, repeated) or commas (with optional
-//!   blanks around them): `t` [s, GPS seconds of week], `dtheta_x y z` [rad],
+//!   7 numbers separated by blanks (spaces or tabs, repeated) or one comma or semicolon
+//!   (with optional blanks around it): `t` [s, GPS seconds of week], `dtheta_x y z` [rad],
 //!   `dvel_x y z` [m/s], body axes FRD. Each line holds the increments over
 //!   `(t_prev, t]`, `t_prev` the previous line's time. With [`ImuLayout::Rates`] the
 //!   same columns are read as angular rate `w_x y z` [rad/s] and specific force
@@ -13,8 +13,10 @@
 //!   the same separators, the columns named by the caller (`t,fx,fy,fz,wx,wy,wz`, `_`
 //!   for a column to skip, a last `...` for further columns to ignore); the names say
 //!   rates or increments (see [`super::imu_columns`]).
-//! - **CSV** (our native format): a header row, then comma-separated rows with as many
-//!   fields as the header. Columns are found by name (see [`super::imu_columns`] for
+//! - **CSV** (our native format): a header row, then rows with as many fields as the
+//!   header, separated by the header's delimiter (a comma, or a semicolon as written
+//!   where the comma is the decimal mark; a decimal comma in a number is refused). A
+//!   header of blank-separated names heads rows read as text. Columns are found by name (see [`super::imu_columns`] for
 //!   every name and unit recognised): `t` (or `time`, `timestamp`), then either
 //!   increments `dtheta_x, dtheta_y, dtheta_z, dvel_x, dvel_y, dvel_z` [rad, m/s] or
 //!   rates `w_x, w_y, w_z, f_x, f_y, f_z` [rad/s, m/s²], or common names such as
@@ -273,8 +275,11 @@ impl ProgressCounter {
 
 /// How a line's fields map to slots (0 time, 1–3 gyro, 4–6 accelerometer).
 struct Columns {
-    /// Comma-separated only (CSV), else blanks or commas (text).
+    /// Separated by [`Self::delim`] only (CSV), else by blanks, commas or semicolons
+    /// (text).
     csv: bool,
+    /// The CSV's field delimiter (`,` or `;`, told by the header).
+    delim: u8,
     /// Column i's slot, or [`UNUSED`].
     slot_of_col: Vec<u8>,
     /// The columns' names, for messages.
@@ -296,6 +301,7 @@ impl Columns {
         };
         Self {
             csv: false,
+            delim: b',',
             slot_of_col: (0..7).collect(),
             names: names.iter().map(|&n| n.to_owned()).collect(),
             time_col: 0,
@@ -305,10 +311,20 @@ impl Columns {
     }
 }
 
-/// The column names of a CSV header line: each trimmed of blanks and of one pair of
-/// double quotes.
-fn header_names(line: &[u8]) -> Vec<String> {
-    line.split(|&b| b == b',')
+/// The delimiter of a header line: the first comma or semicolon it holds, else none
+/// (the names and the data are separated by blanks, as in text).
+fn header_delimiter(line: &[u8]) -> Option<u8> {
+    line.iter().copied().find(|&b| is_mark(b))
+}
+
+/// The column names of a header line separated by `delim` (or by blanks without one):
+/// each trimmed of blanks and of one pair of double quotes.
+fn header_names(line: &[u8], delim: Option<u8>) -> Vec<String> {
+    let split: Box<dyn Iterator<Item = &[u8]>> = match delim {
+        Some(d) => Box::new(line.split(move |&b| b == d)),
+        None => Box::new(line.split(|&b| is_blank(b)).filter(|f| !f.is_empty())),
+    };
+    split
         .map(|raw| {
             let text = String::from_utf8_lossy(raw);
             let text = text.trim_matches([' ', '\t']);
@@ -350,6 +366,12 @@ struct Record {
     v: [f64; 6],
 }
 
+/// Whether a comma or a semicolon: the separators of text lines besides blanks.
+#[inline]
+fn is_mark(b: u8) -> bool {
+    b == b',' || b == b';'
+}
+
 #[inline]
 fn skip_blanks(line: &[u8], mut pos: usize) -> usize {
     while pos < line.len() && is_blank(line[pos]) {
@@ -358,13 +380,14 @@ fn skip_blanks(line: &[u8], mut pos: usize) -> usize {
     pos
 }
 
-/// Parses a number at `line[start..]` that ends at a blank, a comma or the line end;
+/// Parses a number at `line[start..]` that ends at a blank, a comma, a semicolon or the
+/// line end;
 /// returns it and the index just past it.
 #[inline]
 fn parse_number(line: &[u8], start: usize, col: usize) -> Result<(f64, usize), FieldError> {
     let rest = &line[start..];
     match fast_float2::parse_partial::<f64, _>(rest) {
-        Ok((v, n)) if n > 0 && rest.get(n).is_none_or(|&b| is_blank(b) || b == b',') => {
+        Ok((v, n)) if n > 0 && rest.get(n).is_none_or(|&b| is_blank(b) || is_mark(b)) => {
             if v.is_finite() {
                 Ok((v, start + n))
             } else {
@@ -383,32 +406,34 @@ fn parse_number(line: &[u8], start: usize, col: usize) -> Result<(f64, usize), F
     }
 }
 
-/// Text format: skips one separator (blanks, at most one comma, blanks).
+/// Text format: skips one separator (blanks, at most one comma or semicolon, blanks).
 #[inline]
 fn skip_text_separator(line: &[u8], pos: usize) -> usize {
     let pos = skip_blanks(line, pos);
-    if pos < line.len() && line[pos] == b',' {
+    if pos < line.len() && is_mark(line[pos]) {
         skip_blanks(line, pos + 1)
     } else {
         pos
     }
 }
 
-/// Text format: end of the field starting at `start` (next blank, comma or line end).
+/// Text format: end of the field starting at `start` (next blank, comma, semicolon or
+/// line end).
 fn text_field_end(line: &[u8], start: usize) -> usize {
     line[start..]
         .iter()
-        .position(|&b| is_blank(b) || b == b',')
+        .position(|&b| is_blank(b) || is_mark(b))
         .map_or(line.len(), |n| start + n)
 }
 
-/// Text format: number of fields on a line (an empty field between two commas counts).
+/// Text format: number of fields on a line (an empty field between two commas or
+/// semicolons counts).
 fn count_text_fields(line: &[u8]) -> usize {
     let mut n = 0;
     let mut pos = skip_blanks(line, 0);
     while pos < line.len() {
         n += 1;
-        if line[pos] != b',' {
+        if !is_mark(line[pos]) {
             pos = text_field_end(line, pos);
         }
         pos = skip_text_separator(line, pos);
@@ -437,7 +462,7 @@ fn parse_text_line<const MAPPED: bool>(
         // `col` < 7 without a map: KF-GINS text has 7 slots.
         let slot = if MAPPED { slots[col] } else { col as u8 };
         if MAPPED && slot == UNUSED && pos < line.len() {
-            let end = if line[pos] == b',' {
+            let end = if is_mark(line[pos]) {
                 pos
             } else {
                 text_field_end(line, pos)
@@ -447,7 +472,7 @@ fn parse_text_line<const MAPPED: bool>(
         }
         let res = if pos >= line.len() {
             Err(FieldError::Columns { found: col })
-        } else if line[pos] == b',' {
+        } else if is_mark(line[pos]) {
             Err(FieldError::Empty { col })
         } else {
             parse_number(line, pos, col)
@@ -493,16 +518,16 @@ fn text_error(line: &[u8], expected: usize, trailing: bool, e: FieldError) -> Fi
     }
 }
 
-/// CSV: number of fields (commas + 1).
-fn count_csv_fields(line: &[u8]) -> usize {
-    line.iter().filter(|&&b| b == b',').count() + 1
+/// CSV: number of fields (delimiters + 1).
+fn count_csv_fields(line: &[u8], delim: u8) -> usize {
+    line.iter().filter(|&&b| b == delim).count() + 1
 }
 
 /// CSV: the field at `start` trimmed of blanks: `(start, end)`.
-fn csv_field_bounds(line: &[u8], start: usize) -> (usize, usize) {
+fn csv_field_bounds(line: &[u8], start: usize, delim: u8) -> (usize, usize) {
     let end = line[start..]
         .iter()
-        .position(|&b| b == b',')
+        .position(|&b| b == delim)
         .map_or(line.len(), |n| start + n);
     let s = skip_blanks(line, start).min(end);
     let mut e = end;
@@ -519,13 +544,14 @@ fn csv_field_bounds(line: &[u8], start: usize) -> (usize, usize) {
 fn parse_csv_line(
     line: &[u8],
     slot_of_col: &[u8],
+    delim: u8,
     (time_only, trailing): (bool, bool),
     out: &mut [f64; 7],
     time: &mut Span,
 ) -> Result<(), FieldError> {
     let len = line.len();
     let ncols = slot_of_col.len();
-    let fail = |e| Err(csv_error(line, ncols, trailing, e));
+    let fail = |e| Err(csv_error(line, delim, ncols, trailing, e));
     // Start of the current field; `len + 1` once the line has no more fields.
     let mut pos = 0;
     for (col, &slot) in slot_of_col.iter().enumerate() {
@@ -539,7 +565,7 @@ fn parse_csv_line(
         };
         let next = if wanted {
             let start = skip_blanks(line, pos);
-            if start >= len || line[start] == b',' {
+            if start >= len || line[start] == delim {
                 return fail(FieldError::Empty { col });
             }
             let (v, end) = match parse_number(line, start, col) {
@@ -547,7 +573,7 @@ fn parse_csv_line(
                 Err(e) => return fail(e),
             };
             let after = skip_blanks(line, end);
-            if after < len && line[after] != b',' {
+            if after < len && line[after] != delim {
                 return fail(FieldError::NotANumber {
                     col,
                     start,
@@ -565,14 +591,14 @@ fn parse_csv_line(
         } else {
             line[pos..]
                 .iter()
-                .position(|&b| b == b',')
+                .position(|&b| b == delim)
                 .map_or(len, |n| pos + n)
         };
         pos = next + 1;
     }
     if pos <= len && !trailing {
         return Err(FieldError::Columns {
-            found: count_csv_fields(line),
+            found: count_csv_fields(line, delim),
         });
     }
     Ok(())
@@ -580,14 +606,14 @@ fn parse_csv_line(
 
 /// CSV: a wrong column count outranks a bad field; fills in a bad field's bounds.
 #[cold]
-fn csv_error(line: &[u8], ncols: usize, trailing: bool, e: FieldError) -> FieldError {
-    let found = count_csv_fields(line);
+fn csv_error(line: &[u8], delim: u8, ncols: usize, trailing: bool, e: FieldError) -> FieldError {
+    let found = count_csv_fields(line, delim);
     if wrong_count(found, ncols, trailing) {
         return FieldError::Columns { found };
     }
     match e {
         FieldError::NotANumber { col, start, .. } => {
-            let (start, end) = csv_field_bounds(line, start);
+            let (start, end) = csv_field_bounds(line, start, delim);
             FieldError::NotANumber { col, start, end }
         }
         other => other,
@@ -779,9 +805,13 @@ impl<R: BufRead> ImuReader<R> {
                 ImuFormat::KfGinsText
             };
         }
-        let csv = self.format == ImuFormat::Csv;
+        let headed = self.format == ImuFormat::Csv;
+        // A header without commas or semicolons names blank-separated columns: the
+        // rows are then read as text.
+        let delim = header_delimiter(self.lines.line());
+        let csv = headed && delim.is_some();
         let declared = options.declared();
-        let (plan, names, trailing) = match (&options.columns, csv) {
+        let (plan, names, trailing) = match (&options.columns, headed) {
             (Some(spec), _) => {
                 let names = spec.names().to_vec();
                 // Whatever is wrong is in the options, not in the file.
@@ -794,7 +824,7 @@ impl<R: BufRead> ImuReader<R> {
                 (plan, names, spec.trailing())
             }
             (None, true) => {
-                let names = header_names(self.lines.line());
+                let names = header_names(self.lines.line(), delim);
                 let cols = names
                     .iter()
                     .map(|n| recognise(n))
@@ -810,16 +840,18 @@ impl<R: BufRead> ImuReader<R> {
             }
         };
         let plan = plan.map_err(|e| self.plan_error(e))?;
-        self.apply_plan(&plan, options, csv, names, trailing);
-        Ok(!csv)
+        let delim = if csv { delim } else { None };
+        self.apply_plan(&plan, options, delim, names, trailing);
+        Ok(!headed)
     }
 
-    /// Takes `plan` with the columns' `names` (empty: KF-GINS's).
+    /// Takes `plan` with the columns' `names` (empty: KF-GINS's), the rows separated
+    /// by `delim` (CSV) or as text (none).
     fn apply_plan(
         &mut self,
         plan: &Plan,
         options: &ImuReadOptions,
-        csv: bool,
+        delim: Option<u8>,
         names: Vec<String>,
         trailing: bool,
     ) {
@@ -830,7 +862,8 @@ impl<R: BufRead> ImuReader<R> {
             Columns::kf_gins(plan.layout)
         } else {
             Columns {
-                csv,
+                csv: delim.is_some(),
+                delim: delim.unwrap_or(b','),
                 slot_of_col: plan.slot_of_col.clone(),
                 names,
                 time_col: plan.time_col,
@@ -977,6 +1010,7 @@ impl<R: BufRead> ImuReader<R> {
             parse_csv_line(
                 line,
                 &c.slot_of_col,
+                c.delim,
                 (time_only, c.trailing),
                 out,
                 &mut span,
@@ -1349,6 +1383,31 @@ mod tests {
         let b = read_all(commas, &text()).expect("commas");
         assert_eq!(a, b);
         assert_eq!(a[1].dvel, Vector3::new(0.4, 0.5, 0.6));
+        let semicolons = "1.0;0.1;0.2;0.3;0.4;0.5;0.6\n1.5 ; 0.1;0.2;0.3;0.4;0.5;0.6;\n";
+        assert_eq!(read_all(semicolons, &text()).expect("semicolons"), a);
+    }
+
+    /// The same two samples under a header delimited by commas, by semicolons, and by
+    /// blanks read alike; a decimal comma under a semicolon header is refused by name.
+    #[test]
+    fn header_delimiters_read_alike() {
+        let rows = |sep: &str| {
+            let header = [
+                "t", "dvel_x", "dvel_y", "dvel_z", "dtheta_x", "dtheta_y", "dtheta_z",
+            ];
+            let r1 = ["1.0", "0.4", "0.5", "0.6", "0.1", "0.2", "0.3"];
+            let r2 = ["1.5", "0.4", "0.5", "0.6", "0.1", "0.2", "0.3"];
+            [header, r1, r2].map(|r| r.join(sep)).join("\n")
+        };
+        let opts = ImuReadOptions::default();
+        let commas = read_all(&rows(","), &opts).expect("commas");
+        assert_eq!(commas[1].dtheta, Vector3::new(0.1, 0.2, 0.3));
+        assert_eq!(commas[1].dvel, Vector3::new(0.4, 0.5, 0.6));
+        assert_eq!(read_all(&rows(";"), &opts).expect("semicolons"), commas);
+        assert_eq!(read_all(&rows(" \t "), &opts).expect("blanks"), commas);
+        let decimal_comma = rows(";").replace("0.5", "0,5");
+        let e = read_err(&decimal_comma, &opts);
+        assert_err(&e, 2, Some("dvel_y"), InputErrorKind::NotANumber, "\"0,5\"");
     }
 
     #[test]
