@@ -339,7 +339,7 @@ fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {
 
 /// The flag of `nav` that sets a session configuration field.
 fn flag_of(field: &str) -> &'static str {
-    const FLAGS: [(&str, &str); 28] = [
+    const FLAGS: [(&str, &str); 40] = [
         ("mechanization.auto_latitude", "--auto-latitude"),
         ("mechanization.hysteresis", "--auto-hysteresis"),
         ("output_rate", "--output-rate"),
@@ -380,6 +380,30 @@ fn flag_of(field: &str) -> &'static str {
         ("filter.vehicle.odometer_std", "--odometer-std"),
         ("filter.vehicle.odometer_scale_std", "--odometer-scale-std"),
         ("filter.vehicle.mounting_std", "--estimate-mounting"),
+        ("filter.vehicle.mount.lever", "--vehicle-lever-arm"),
+        ("filter.vehicle.mount.q_vb", "--mounting-angles"),
+        (
+            "filter.integration.init_sensor_std",
+            "the initial sensor-error standard deviations",
+        ),
+        ("start.state.pos.lat", "--init-pos"),
+        ("start.state.pos.lon", "--init-pos"),
+        ("start.state.pos.h", "--init-pos"),
+        ("start.state.v_n", "--init-vel"),
+        ("start.state.q_bn", "--init-att"),
+        ("start.estimates.gyro_bias", "the initial gyro bias"),
+        (
+            "start.estimates.accel_bias",
+            "the initial accelerometer bias",
+        ),
+        (
+            "start.estimates.gyro_scale",
+            "the initial gyro scale factor",
+        ),
+        (
+            "start.estimates.accel_scale",
+            "the initial accelerometer scale factor",
+        ),
     ];
     FLAGS
         .iter()
@@ -416,7 +440,10 @@ mod tests {
         };
         let e = named_flag(cfg.validate().expect_err("negative std").into()).to_string();
         assert!(
-            e.starts_with("--init-vel-std (filter.integration.init_vel_std): must be"),
+            e.starts_with(
+                "--init-vel-std (filter.integration.init_vel_std): velocity standard \
+                 deviation -1 m/s is outside (0, 12000] m/s"
+            ),
             "{e}"
         );
     }

@@ -8,6 +8,7 @@
 pub mod align;
 pub mod analysis;
 pub mod channel;
+pub mod domain;
 pub mod earth;
 pub mod filter;
 pub mod imu;

@@ -20,7 +20,7 @@ use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
 use crate::options::{EarthChoice, GradeChoice, MechanizationChoice, Triple, rate};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
 use schuler::earth::{Geodetic, Sphere, Wgs84};
@@ -150,8 +150,7 @@ pub enum InitChoice {
 }
 
 fn load_config(path: &Path) -> Result<NavConfig> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::formats::read_config_text(path)?;
     let (mut cfg, input): (NavConfig, _) =
         ImuInputOptions::split_config(&text).with_context(|| format!("in {}", path.display()))?;
     cfg.input = input;
@@ -213,10 +212,8 @@ fn init_pos(args: &NavArgs, cfg: &NavConfig) -> Result<Geodetic> {
         .init_pos
         .or(cfg.init_pos)
         .context("no initial position: give --init-pos LAT,LON,H (deg, deg, m)")?;
-    if !(-90.0..=90.0).contains(&lat) {
-        bail!("--init-pos: latitude {lat} deg is outside [-90, 90]");
-    }
-    Ok(Geodetic::from_degrees(lat, lon, h))
+    crate::formats::gnss::position_in_domain(lat, lon, h)
+        .map_err(|(_, e)| anyhow!("--init-pos: {e}"))
 }
 
 /// The initial attitude of flags over config (zero when aligning), checked.

@@ -148,8 +148,7 @@ pub struct Config {
 
 /// Reads and checks a config; errors name the key.
 pub fn load(path: &Path) -> Result<Config> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::formats::read_config_text(path)?;
     let spec: ConfigSpec =
         toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
     parse(spec).with_context(|| format!("in {}", path.display()))

@@ -481,14 +481,13 @@ impl Files {
 /// Read and parse a scenario file, and the gnss-ins-sim motion file it names (a path
 /// relative to the scenario's folder).
 pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::formats::read_config_text(path)?;
     let mut spec: ScenarioSpec =
         toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
     if let Some(csv) = &spec.motion_csv {
         let csv_path = path.parent().unwrap_or(Path::new("")).join(csv);
-        let text = std::fs::read_to_string(&csv_path)
-            .with_context(|| format!("cannot read {}", csv_path.display()))?;
+        let text =
+            String::from_utf8_lossy(&crate::formats::read_lines_whole(&csv_path)?).into_owned();
         let def = schuler::sim::gnss_ins_sim::parse(&text)
             .with_context(|| format!("in {}", csv_path.display()))?;
         spec.imported = Some(def);

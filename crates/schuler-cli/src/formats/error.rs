@@ -27,6 +27,9 @@ pub enum InputErrorKind {
     /// Earth reads as declared (rates where increments are expected, units or columns
     /// mistaken), or a GNSS position log given as a velocity log.
     LayoutMismatch,
+    /// A value is outside its physical domain ([`schuler::domain`]): a latitude
+    /// beyond the pole, an angular rate no gyro reads, a gap no integration step spans.
+    OutOfDomain,
     /// A reader option (nominal interval, time window) is invalid, or the file holds
     /// too little data to establish what the reader needs.
     Usage,

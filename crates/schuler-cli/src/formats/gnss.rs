@@ -69,8 +69,9 @@
 //! `baro.csv` as `schuler simulate` writes it (`t,h_m,outlier`) or headerless `t h`.
 
 use super::error::{InputError, InputErrorKind};
-use super::lines::{Delimiter, data_lines, fields};
+use super::lines::{Delimiter, data_lines, fields, read_lines_whole};
 use nalgebra::Vector3;
+use schuler::domain;
 use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
 use std::path::Path;
@@ -199,19 +200,6 @@ pub struct GnssLog {
     pub warnings: Vec<String>,
 }
 
-/// The bytes of a small log.
-pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, InputError> {
-    std::fs::read(path).map_err(|e| {
-        InputError::new(
-            InputErrorKind::Io,
-            path,
-            0,
-            None,
-            format!("cannot read: {e}"),
-        )
-    })
-}
-
 /// `bytes` as text (a leading UTF-8 byte-order mark dropped), or an error naming the
 /// line of the first byte that is not UTF-8.
 pub(crate) fn utf8_text(path: &Path, bytes: Vec<u8>) -> Result<String, InputError> {
@@ -234,7 +222,7 @@ pub(crate) fn utf8_text(path: &Path, bytes: Vec<u8>) -> Result<String, InputErro
 
 /// The whole text of a small log (a leading UTF-8 byte-order mark dropped).
 fn read_text(path: &Path) -> Result<String, InputError> {
-    utf8_text(path, read_bytes(path)?)
+    utf8_text(path, read_lines_whole(path)?)
 }
 
 /// Whether the first data line is a CSV header: its first field is not a number.
@@ -631,33 +619,49 @@ fn csv_position_rows<'l>(
     Ok(out)
 }
 
+/// The position of latitude, longitude [deg] and height [m] after the checks of
+/// [`schuler::domain`] (a longitude of 0-360 wrapped); else which of the three (0, 1,
+/// 2) is out of its domain, and why.
+pub(crate) fn position_in_domain(
+    lat_deg: f64,
+    lon_deg: f64,
+    h: f64,
+) -> Result<Geodetic, (usize, domain::DomainError)> {
+    let lat = domain::LATITUDE
+        .check_in_unit(lat_deg)
+        .map_err(|e| (0, e))?;
+    let lon = domain::wrap_longitude(lon_deg.to_radians()).map_err(|e| (1, e))?;
+    let h = domain::HEIGHT.check(h).map_err(|e| (2, e))?;
+    Ok(Geodetic { lat, lon, h })
+}
+
 /// The record of line `n`'s values `v` (`t lat lon h [std_n std_e std_d [vn ve vd
-/// std_vn std_ve std_vd]]`) after checking the latitude (named `lat_name` in the
-/// error); `default_std` where `v` gives no standard deviations.
+/// std_vn std_ve std_vd]]`) after checking the position's domain (the fields named
+/// `pos_names` in the error); `default_std` where `v` gives no standard deviations.
 fn gnss_record(
     path: &Path,
     n: u64,
     v: &[f64],
     outlier: Option<bool>,
-    (lat_name, std_name): (&str, &str),
+    (pos_names, std_name): ([&str; 3], &str),
     std: Option<Vector3<f64>>,
 ) -> Result<GnssRecord, InputError> {
-    if !(-90.0..=90.0).contains(&v[1]) {
-        return Err(InputError::new(
-            InputErrorKind::NotANumber,
+    let pos = position_in_domain(v[1], v[2], v[3]).map_err(|(i, e)| {
+        InputError::new(
+            InputErrorKind::OutOfDomain,
             path,
             n,
-            Some(lat_name),
-            format!("latitude {} is outside [-90, 90]", v[1]),
-        ));
-    }
+            Some(pos_names[i]),
+            e.to_string(),
+        )
+    })?;
     let pos_std = match v.get(4..7) {
         Some(s) => Vector3::new(s[0], s[1], s[2]),
         None => default_std(path, n, std_name, std)?,
     };
     let fix = GnssFix {
         t: v[0],
-        pos: Geodetic::from_degrees(v[1], v[2], v[3]),
+        pos,
         pos_std,
         vel: (v.len() == 13).then(|| {
             (
@@ -700,10 +704,13 @@ pub fn read_text_records(
                 rows.into_iter()
                     .map(|(n, v)| (n, v, None))
                     .collect::<Vec<_>>(),
-                ("lat", "std_n"),
+                (["lat", "lon", "h"], "std_n"),
             )
         }
-        Some(h) => (csv_position_rows(path, h, lines)?, ("lat_deg", "std_n_m")),
+        Some(h) => (
+            csv_position_rows(path, h, lines)?,
+            (["lat_deg", "lon_deg", "h_m"], "std_n_m"),
+        ),
     };
     rows.into_iter()
         .map(|(n, v, outlier)| gnss_record(path, n, &v, outlier, names, default_std))
@@ -769,7 +776,7 @@ fn detect(bytes: &[u8]) -> GnssFormat {
 /// the content): the fixes in time order, with velocity where the format gives it,
 /// and the reader's warnings.
 pub fn read_gnss_log(path: &Path, opts: &GnssReadOptions) -> Result<GnssLog, InputError> {
-    let bytes = read_bytes(path)?;
+    let bytes = read_lines_whole(path)?;
     let format = match opts.format {
         GnssFormat::Auto => detect(&bytes),
         f => f,
@@ -904,29 +911,61 @@ fn check_not_position(path: &Path, n: u64, v: &[f64], fix: &GnssFix) -> Result<(
     Ok(())
 }
 
-/// Read a barometer log: `baro.csv` as `schuler simulate` writes it (header
-/// `t,h_m[,outlier]`; the outlier flag, the simulator's truth, is not read) or headerless
-/// `t h` rows. Returns `(t, h)` pairs in time order.
+/// Names of a barometer header's time column (any case).
+const BARO_TIME_NAMES: [&str; 3] = ["t", "time", "timestamp"];
+/// Names of a barometer header's height column [m] (any case).
+const BARO_HEIGHT_NAMES: [&str; 6] = ["h_m", "h", "height", "height_m", "alt", "altitude"];
+
+/// The time and height columns a barometer header (line `n`) names.
+fn baro_columns(path: &Path, n: u64, header: &str) -> Result<[usize; 2], InputError> {
+    let names: Vec<String> = fields(header).map(str::to_lowercase).collect();
+    let find = |wanted: &[&str]| names.iter().position(|n| wanted.contains(&n.as_str()));
+    match (find(&BARO_TIME_NAMES), find(&BARO_HEIGHT_NAMES)) {
+        (Some(t), Some(h)) => Ok([t, h]),
+        _ => Err(InputError::new(
+            InputErrorKind::Header,
+            path,
+            n,
+            None,
+            format!(
+                "a barometer header names its time ({}) and its height in metres ({}); \
+                 this one names {}",
+                BARO_TIME_NAMES.join(", "),
+                BARO_HEIGHT_NAMES.join(", "),
+                names.join(", ")
+            ),
+        )),
+    }
+}
+
+/// Read a barometer log: a CSV whose header names the time and the height columns in
+/// any order (as `schuler simulate`'s `baro.csv`, `t,h_m[,outlier]`; other columns,
+/// the simulator's outlier truth among them, are not read), or headerless `t h` rows.
+/// Returns `(t, h)` pairs in time order.
 pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
     let text = read_text(path)?;
     let mut lines = data_lines(&text).peekable();
-    if lines.peek().is_some_and(|&(_, l)| is_header(l)) {
-        lines.next();
-    }
+    let [tc, hc] = match lines.peek() {
+        Some(&(n, l)) if is_header(l) => {
+            lines.next();
+            baro_columns(path, n, l)?
+        }
+        _ => [0, 1],
+    };
     let mut out: Vec<(f64, f64)> = Vec::new();
     for (n, l) in lines {
         let f: Vec<&str> = fields(l).collect();
-        if f.len() < 2 {
+        if f.len() <= tc.max(hc) {
             return Err(InputError::new(
                 InputErrorKind::ColumnCount,
                 path,
                 n,
                 None,
-                "expected t and h",
+                format!("{} fields, expected t and h", f.len()),
             ));
         }
-        let t = parse_field(path, n, "time", f[0], "")?;
-        let h = parse_field(path, n, "h", f[1], "")?;
+        let t = parse_field(path, n, "time", f[tc], "")?;
+        let h = parse_field(path, n, "h", f[hc], "")?;
         check_time(path, n, "time", t, out.last().map(|p| p.0))?;
         out.push((t, h));
     }
@@ -1027,7 +1066,7 @@ mod tests {
             ),
             (
                 &format!("{SIM_HEADER}\n1,95,7,1,1,1,1,0,0,0,0,0,0,0\n"),
-                ":2: field lat_deg: latitude 95 is outside",
+                ":2: field lat_deg: latitude 95 deg is outside",
             ),
             (
                 &format!(
@@ -1159,6 +1198,16 @@ mod tests {
         let f = file("t,h_m,outlier\n0.1,abc,0\n");
         let e = read_baro(f.path()).expect_err("bad").to_string();
         assert!(e.contains(":2: field h"), "{e}");
+        // The header's order is honoured (it used to be ignored: column 2 was read as
+        // the height whatever the header said), with a byte-order mark in front.
+        let f = file("\u{feff}pressure_pa;Altitude;Time\n101000;100.5;0.1\n101001;100.7;0.2\n");
+        assert_eq!(
+            read_baro(f.path()).expect("reads"),
+            vec![(0.1, 100.5), (0.2, 100.7)]
+        );
+        let f = file("t,pressure_pa\n0.1,101000\n");
+        let e = read_baro(f.path()).expect_err("no height").to_string();
+        assert!(e.contains(":1: a barometer header names its time"), "{e}");
     }
 
     #[test]
@@ -1237,6 +1286,21 @@ mod tests {
                 "increase",
             ),
             ("1 95 7 100 0.5 0.5 1\n", "field lat", "outside"),
+            (
+                "1 45 400 100 0.5 0.5 1\n",
+                "field lon",
+                "longitude 400 deg is outside",
+            ),
+            (
+                "1 45 7 -1e7 0.5 0.5 1\n",
+                "field h",
+                "height -10000000 m is outside",
+            ),
+            (
+                "1 45 7 1e12 0.5 0.5 1\n",
+                "field h",
+                "outside [-12000, 100000000] m",
+            ),
         ];
         for (text, at, what) in cases {
             let f = file(text);

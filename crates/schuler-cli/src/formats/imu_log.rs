@@ -26,6 +26,11 @@
 //!   rates. With [`ImuReadOptions::columns`] the header line is skipped and the columns
 //!   are the caller's. Quoted data fields are not supported.
 //!
+//! Every sample is checked against the physical domains of [`schuler::domain`]: an
+//! interval longer than a minute (a gap would be integrated as free fall), an angular
+//! rate or a specific force no sensor reads. Such a line stops the reading with an
+//! [`InputErrorKind::OutOfDomain`] naming it and its columns.
+//!
 //! In all, blank lines and lines whose first non-blank byte is `#` or `%` are skipped,
 //! a UTF-8 byte-order mark and `\r\n` line ends are accepted, and line numbers in
 //! errors count every line of the file (1-based).
@@ -86,6 +91,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use nalgebra::{Matrix3, Vector3};
+use schuler::domain;
 use schuler::imu::ImuSample;
 
 use super::error::{InputError, InputErrorKind, quote_field};
@@ -364,6 +370,8 @@ enum FieldError {
 struct Record {
     t: f64,
     v: [f64; 6],
+    /// The 1-based line it was read from.
+    line: u64,
 }
 
 /// Whether a comma or a semicolon: the separators of text lines besides blanks.
@@ -1072,6 +1080,7 @@ impl<R: BufRead> ImuReader<R> {
         Ok(Record {
             t,
             v: [out[1], out[2], out[3], out[4], out[5], out[6]],
+            line: line_no,
         })
     }
 
@@ -1151,6 +1160,41 @@ impl<R: BufRead> ImuReader<R> {
             Some(&self.sensor_field(finding.sensor)),
             format!("lines {first_line}-{last_line} {}", finding.message),
         ))
+    }
+
+    /// Checks a sample of line `line` against the physical domains: its interval (when
+    /// it follows another sample), its angular rate and its specific force.
+    #[inline]
+    fn check_domain(&self, s: &ImuSample, had_prev: bool, line: u64) -> Result<(), InputError> {
+        let checks = [
+            (
+                Sensor::Time,
+                &domain::IMU_INTERVAL,
+                if had_prev { s.dt } else { 0.0 },
+            ),
+            (Sensor::Gyro, &domain::ANGULAR_RATE, s.dtheta.norm() / s.dt),
+            (Sensor::Accel, &domain::SPECIFIC_FORCE, s.dvel.norm() / s.dt),
+        ];
+        for (sensor, d, value) in checks {
+            if let Err(e) = d.check(value) {
+                return Err(self.domain_error(sensor, line, e));
+            }
+        }
+        Ok(())
+    }
+
+    #[cold]
+    fn domain_error(&self, sensor: Sensor, line: u64, e: domain::DomainError) -> InputError {
+        let what = match sensor {
+            Sensor::Time => format!("the time jumps: {e}"),
+            _ => e.to_string(),
+        };
+        self.error(
+            InputErrorKind::OutOfDomain,
+            line,
+            Some(&self.sensor_field(sensor)),
+            what,
+        )
     }
 
     /// The columns of a sensor, for messages: `dvel (columns 5-7)` in text, the names in
@@ -1279,6 +1323,10 @@ impl<R: BufRead> Iterator for ImuReader<R> {
                 dtheta: Vector3::new(v[0], v[1], v[2]) * (self.to_si.0 * per),
                 dvel: Vector3::new(v[3], v[4], v[5]) * (self.to_si.1 * per),
             };
+            if let Err(e) = self.check_domain(&sample, had_prev, record.line) {
+                self.finished = true;
+                return Some(Err(e));
+            }
             return Some(Ok(match &self.c_vs {
                 Some(c_vs) => sample.rotated(c_vs),
                 None => sample,
@@ -1355,7 +1403,7 @@ mod tests {
                      \n\
                      456789.000 0.001 -0.002 3e-4 0.0049 -0.0051 -0.049\r\n\
                      456789.005\t0.0011\t-0.0021  3.1e-4\t\t0.00491 -0.00511 -0.0491\n\
-                     \x20 456789.010 1 2 3 4 5 6   \n";
+                     \x20 456789.010 0.1 0.2 0.3 4 5 6   \n";
         let samples = read_all(input, &text()).expect("good file");
         assert_eq!(samples.len(), 3);
         let s = &samples[1];
@@ -1385,6 +1433,38 @@ mod tests {
         assert_eq!(a[1].dvel, Vector3::new(0.4, 0.5, 0.6));
         let semicolons = "1.0;0.1;0.2;0.3;0.4;0.5;0.6\n1.5 ; 0.1;0.2;0.3;0.4;0.5;0.6;\n";
         assert_eq!(read_all(semicolons, &text()).expect("semicolons"), a);
+    }
+
+    /// Issue 21's reproducers: one row with a huge finite increment, or a clock jump of
+    /// 1e9 s, used to be integrated into NaN or a position 1e36 m away; each is refused
+    /// naming its line and columns.
+    #[test]
+    fn out_of_domain_rows_are_refused_by_line() {
+        let opts = text();
+        let good = stationary_text(40, 200.0, 100.0, ImuLayout::Increments);
+        // The log with field `col` of data rows `rows` replaced by `f(old value)`.
+        let edit = |rows: std::ops::RangeFrom<usize>, col: usize, f: &dyn Fn(f64) -> f64| {
+            let mut out = String::new();
+            for (i, line) in good.lines().enumerate() {
+                let mut v: Vec<f64> = line
+                    .split_whitespace()
+                    .map(|x| x.parse().expect("number"))
+                    .collect();
+                if rows.contains(&i) {
+                    v[col] = f(v[col]);
+                }
+                let v: Vec<String> = v.iter().map(f64::to_string).collect();
+                writeln!(out, "{}", v.join(" ")).expect("writing to a String cannot fail");
+            }
+            out
+        };
+        let kind = InputErrorKind::OutOfDomain;
+        let e = read_err(&edit(30.., 1, &|_| 1e6), &opts);
+        assert_err(&e, 31, Some("dtheta (columns 2-4)"), kind, "angular rate");
+        let e = read_err(&edit(30.., 4, &|_| 1e20), &opts);
+        assert_err(&e, 31, Some("dvel (columns 5-7)"), kind, "specific force");
+        let e = read_err(&edit(30.., 0, &|t| t + 1e9), &opts);
+        assert_err(&e, 31, Some("t"), kind, "the time jumps");
     }
 
     /// The same two samples under a header delimited by commas, by semicolons, and by
@@ -2095,7 +2175,8 @@ mod tests {
 
         #[test]
         fn written_values_read_back_bit_exact(
-            rows in proptest::collection::vec(prop::array::uniform6(-1e3..1e3f64), 2..50),
+            // Within the domains: at most 70 rad/s and 7 g over the 0.25-s steps.
+            rows in proptest::collection::vec(prop::array::uniform6(-10.0..10.0f64), 2..50),
             comma in any::<bool>(),
         ) {
             let sep = if comma { "," } else { "\t" };

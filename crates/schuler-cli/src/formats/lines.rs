@@ -2,11 +2,99 @@
 //! skip rules shared by the text formats.
 
 use std::io::{BufRead, Read};
+use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use super::error::{InputError, InputErrorKind};
+
 /// Longest line a reader accepts [bytes]: bounds memory on a file without newlines.
-pub(crate) const MAX_LINE_BYTES: u64 = 64 * 1024;
+pub const MAX_LINE_BYTES: u64 = 64 * 1024;
+
+/// Largest configuration file read [bytes]: a TOML or YAML configuration is a few
+/// kilobytes; this bounds memory on a stream that never ends.
+pub const MAX_CONFIG_BYTES: u64 = 16 << 20;
+
+/// The UTF-8 byte-order mark, accepted (and dropped) at the start of every text file.
+const BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// The bytes of a whole text file read at once, without a leading byte-order mark;
+/// a line longer than [`MAX_LINE_BYTES`] (a stream without newlines, a binary file) is
+/// an error naming it, so memory stays bounded by the file's real content.
+pub fn read_lines_whole(path: &Path) -> Result<Vec<u8>, InputError> {
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, &e))?;
+    let mut r = LineReader::new(std::io::BufReader::with_capacity(1 << 20, file));
+    let mut out = Vec::new();
+    loop {
+        match r.next_line() {
+            Ok(false) => return Ok(out),
+            Ok(true) => {
+                out.extend_from_slice(r.line());
+                out.push(b'\n');
+            }
+            Err(LineReadError::Io(e)) => return Err(cannot_read(path, &e)),
+            Err(LineReadError::TooLong) => return Err(too_long(path, r.line_no())),
+        }
+    }
+}
+
+/// A configuration file's text, at most [`MAX_CONFIG_BYTES`], without a leading
+/// byte-order mark.
+pub fn read_config_text(path: &Path) -> Result<String, InputError> {
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, &e))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_CONFIG_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| cannot_read(path, &e))?;
+    if bytes.len() as u64 > MAX_CONFIG_BYTES {
+        return Err(InputError::new(
+            InputErrorKind::LineTooLong,
+            path,
+            0,
+            None,
+            format!(
+                "longer than {} MiB: not a configuration file",
+                MAX_CONFIG_BYTES >> 20
+            ),
+        ));
+    }
+    if bytes.starts_with(BOM) {
+        bytes.drain(..BOM.len());
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        InputError::new(
+            InputErrorKind::NotANumber,
+            path,
+            0,
+            None,
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })
+}
+
+fn cannot_read(path: &Path, e: &std::io::Error) -> InputError {
+    InputError::new(
+        InputErrorKind::Io,
+        path,
+        0,
+        None,
+        format!("cannot read: {e}"),
+    )
+}
+
+/// The error of line `n` longer than [`MAX_LINE_BYTES`].
+pub(crate) fn too_long(path: &Path, n: u64) -> InputError {
+    InputError::new(
+        InputErrorKind::LineTooLong,
+        path,
+        n,
+        None,
+        format!(
+            "line longer than {} KiB (not a text log, or no line ends)",
+            MAX_LINE_BYTES >> 10
+        ),
+    )
+}
 
 /// Why [`LineReader::next_line`] failed.
 #[derive(Debug)]
@@ -189,6 +277,26 @@ mod tests {
         let input = vec![b'1'; (MAX_LINE_BYTES as usize) * 3];
         let mut r = LineReader::new(&input[..]);
         assert!(matches!(r.next_line(), Err(LineReadError::TooLong)));
+    }
+
+    #[test]
+    fn whole_files_are_bounded() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let long = dir.path().join("long.txt");
+        let mut text = b"\xEF\xBB\xBF1 2\r\n".to_vec();
+        text.extend(std::iter::repeat_n(b'7', MAX_LINE_BYTES as usize + 1));
+        std::fs::write(&long, &text).expect("write");
+        let e = read_lines_whole(&long).expect_err("too long");
+        assert_eq!((e.line, e.kind), (2, InputErrorKind::LineTooLong));
+        text.truncate(8);
+        std::fs::write(&long, &text).expect("write");
+        assert_eq!(read_lines_whole(&long).expect("short"), b"1 2\n");
+        let big = dir.path().join("big.toml");
+        std::fs::write(&big, vec![b'#'; MAX_CONFIG_BYTES as usize + 1]).expect("write");
+        let e = read_config_text(&big).expect_err("too big");
+        assert!(e.to_string().contains("longer than 16 MiB"), "{e}");
+        std::fs::write(&big, "\u{feff}a = 1\n").expect("write");
+        assert_eq!(read_config_text(&big).expect("small"), "a = 1\n");
     }
 
     #[test]

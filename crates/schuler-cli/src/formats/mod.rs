@@ -20,6 +20,7 @@ pub mod vehicle;
 
 pub use error::InputError;
 pub use imu_log::{ImuFormat, ImuLayout, ImuReadOptions, ImuReader};
+pub use lines::{MAX_CONFIG_BYTES, MAX_LINE_BYTES, read_config_text, read_lines_whole};
 
 /// A temporary file holding `text`, for the readers' tests.
 #[cfg(test)]

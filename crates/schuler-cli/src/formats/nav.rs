@@ -15,12 +15,12 @@
 
 use super::error::{InputError, InputErrorKind, quote_field};
 use super::gps_time::WeekClock;
-use super::lines::{Delimiter, fields, is_skippable};
+use super::lines::{Delimiter, MAX_LINE_BYTES, fields, is_skippable, too_long};
 use nalgebra::Vector3;
 use schuler::analysis::errors::NavRecord;
 use schuler::earth::Geodetic;
 use schuler::rotation::Euler;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 /// The layouts [`read_nav`] tells apart.
@@ -211,7 +211,8 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
     let mut rows: Vec<NavRecord> = Vec::new();
     loop {
         buf.clear();
-        if reader
+        if (&mut reader)
+            .take(MAX_LINE_BYTES)
             .read_until(b'\n', &mut buf)
             .map_err(|e| cannot_read(path, e))?
             == 0
@@ -219,7 +220,15 @@ pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> 
             break;
         }
         n += 1;
-        let l = std::str::from_utf8(&buf)
+        if buf.last() != Some(&b'\n') && buf.len() as u64 == MAX_LINE_BYTES {
+            return Err(too_long(path, n));
+        }
+        let text = if n == 1 {
+            buf.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&buf)
+        } else {
+            &buf
+        };
+        let l = std::str::from_utf8(text)
             .map_err(|_| {
                 InputError::new(InputErrorKind::NotANumber, path, n, None, "not UTF-8 text")
             })?

@@ -37,14 +37,13 @@
 use super::error::InputError;
 use super::gnss::{
     GnssFormat, GnssLog, GnssQuality, GnssReadOptions, below_quality, count_warnings, default_std,
-    no_usable_fix,
+    no_usable_fix, position_in_domain,
 };
 use super::gps_time::{DAY_S, TimeScale, WeekClock, week_sow};
 use ::nmea::ParseResult;
 use ::nmea::sentences::FixType;
 use chrono::{NaiveDate, NaiveTime, Timelike};
 use nalgebra::Vector3;
-use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
 use std::path::Path;
 
@@ -134,8 +133,8 @@ impl Counts {
         let mut w = Vec::new();
         if let Some((line, reason)) = &self.first_bad {
             w.push(format!(
-                "{} bad NMEA sentences skipped (checksum or malformed field; the first at \
-                 line {line}: {reason})",
+                "{} bad NMEA sentences skipped (checksum, malformed field or a position out \
+                 of range; the first at line {line}: {reason})",
                 self.bad
             ));
         }
@@ -410,17 +409,17 @@ fn fix(
         counts.bad(gga.line, "a GGA with a fix lacks its position".to_owned());
         return Ok(None);
     };
-    if !(lat.abs() <= 90.0 && lon.abs() <= 180.0 && altitude.is_finite()) {
-        counts.bad(
-            gga.line,
-            format!("position out of range: {lat} {lon} {altitude}"),
-        );
-        return Ok(None);
-    }
     let separation = gga.separation.unwrap_or_else(|| {
         counts.no_separation += 1;
         0.0
     });
+    let pos = match position_in_domain(lat, lon, altitude + separation) {
+        Ok(pos) => pos,
+        Err((_, e)) => {
+            counts.bad(gga.line, format!("a GGA position out of range: {e}"));
+            return Ok(None);
+        }
+    };
     let sd = e.gst.unwrap_or([None; 3]);
     let pos_std = match sd {
         [Some(n), Some(east), Some(d)] if n > 0.0 && east > 0.0 && d > 0.0 => {
@@ -430,7 +429,7 @@ fn fix(
     };
     Ok(Some(GnssFix {
         t,
-        pos: Geodetic::from_degrees(lat, lon, altitude + separation),
+        pos,
         pos_std,
         vel: velocity(e, opts.vel_std),
     }))
@@ -473,6 +472,7 @@ pub fn read_nmea(path: &Path, bytes: &[u8], opts: &GnssReadOptions) -> Result<Gn
 mod tests {
     use super::*;
     use crate::formats::error::InputErrorKind;
+    use schuler::earth::Geodetic;
 
     /// `body` with its NMEA checksum: `$body*hh`.
     fn sentence(body: &str) -> String {
@@ -532,6 +532,7 @@ mod tests {
             sentence("GNGSV,1,1,00"),
             "garbage".to_owned(),
             sentence("PUBX,00,junk"),
+            sentence("GNGGA,120006.0,4504.2,N,00740.8,E,1,8,1.0,9999999999.0,M,47.5,M,,"),
         ]
         .join("\n");
         let got = read(&log, &with_std()).expect("reads");
@@ -545,8 +546,8 @@ mod tests {
         );
         let w = got.warnings.join("\n");
         for want in [
-            "2 bad NMEA sentences skipped (checksum or malformed field; the first at line 2: \
-             Checksum Mismatch",
+            "3 bad NMEA sentences skipped (checksum, malformed field or a position out of \
+             range; the first at line 2: Checksum Mismatch",
             "1 lines that are not NMEA sentences ignored",
             "1 GGA epochs without a fix (quality 0) skipped",
             "1 GGA epochs of dead reckoning (quality 6) skipped",

@@ -37,12 +37,13 @@
 use super::error::{InputError, InputErrorKind, quote_field};
 use super::gnss::{
     GnssFormat, GnssLog, GnssQuality, GnssReadOptions, below_quality, check_time, count_warnings,
-    default_std, no_usable_fix, parse_field,
+    default_std, no_usable_fix, parse_field, position_in_domain,
 };
 use super::gps_time::{TimeScale, WeekClock, date_of_week, week_sow};
 use super::lines::{fields, is_skippable};
 use chrono::NaiveDate;
 use nalgebra::{Matrix3, Vector3};
+use schuler::domain;
 use schuler::earth::{EarthModel, Geodetic, Wgs84, c_ne};
 use schuler::filter::GnssFix;
 use std::path::Path;
@@ -452,7 +453,12 @@ fn parse_row(row: &Row, clock: &mut WeekClock, vel_std: f64) -> Result<Parsed, I
     let t = clock.seconds(week, sow);
     let pos = if layout.ecef {
         let r = row.triple(Col::Ecef, false)?.unwrap_or_default();
-        Wgs84.ecef_to_geodetic(&r)
+        let pos = Wgs84.ecef_to_geodetic(&r);
+        domain::HEIGHT.check(pos.h).map_err(|e| InputError {
+            kind: InputErrorKind::OutOfDomain,
+            ..row.error(layout.find(Col::Ecef(0)).unwrap_or_default(), e.to_string())
+        })?;
+        pos
     } else {
         let at = |c: Col| {
             layout
@@ -465,11 +471,15 @@ fn parse_row(row: &Row, clock: &mut WeekClock, vel_std: f64) -> Result<Parsed, I
             at(Col::Lon(false)).unwrap_or_default(),
         );
         let lat = row.angle(lat_at, lat_dms)?;
-        if !(-90.0..=90.0).contains(&lat) {
-            return Err(row.error(lat_at, format!("latitude {lat} is outside [-90, 90]")));
-        }
+        let lon = row.angle(lon_at, lon_dms)?;
         let h = row.get(Col::Height)?.unwrap_or_default();
-        Geodetic::from_degrees(lat, row.angle(lon_at, lon_dms)?, h)
+        position_in_domain(lat, lon, h).map_err(|(i, e)| {
+            let at = [lat_at, lon_at, layout.find(Col::Height).unwrap_or_default()][i];
+            InputError {
+                kind: InputErrorKind::OutOfDomain,
+                ..row.error(at, e.to_string())
+            }
+        })?
     };
     let q = row.get(Col::Q)?.map_or(Some(GnssQuality::Single), quality);
     let sd = row.triple(Col::Sd, false)?;
@@ -748,6 +758,14 @@ mod tests {
             (
                 "% GPST e-baseline(m) n-baseline(m) u-baseline(m) Q\n".to_owned(),
                 ":1: field e-baseline(m): an east/north/up baseline",
+            ),
+            (
+                format!("{HEADER}{}\n", row.replace("-105.0", "400.0")),
+                ":3: field longitude(deg): longitude 400 deg is outside [-180, 360] deg",
+            ),
+            (
+                format!("{HEADER}{}\n", row.replace("1578.8", "1e12")),
+                ":3: field height(m): height 1e12 m is outside",
             ),
             (HEADER.to_owned(), "sol.pos: no data line"),
         ];

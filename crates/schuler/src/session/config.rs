@@ -5,6 +5,7 @@
 
 use crate::channel::detector::DetectorConfig;
 use crate::channel::vertical::Gains;
+use crate::domain::{self, Domain};
 use crate::filter::{Baseline, Gate, ImuNoise, IntegrationConfig, VehicleMount};
 use nalgebra::{SMatrix, Vector3};
 
@@ -21,7 +22,7 @@ pub struct ConfigError {
 }
 
 impl ConfigError {
-    fn new(field: &'static str, reason: impl Into<String>) -> Self {
+    pub(super) fn new(field: &'static str, reason: impl Into<String>) -> Self {
         Self {
             field,
             reason: reason.into(),
@@ -291,23 +292,83 @@ fn non_negative(field: &'static str, x: f64) -> Result<(), ConfigError> {
     }
 }
 
-fn each(
-    field: &'static str,
-    v: &Vector3<f64>,
-    check: fn(&'static str, f64) -> Result<(), ConfigError>,
-) -> Result<(), ConfigError> {
-    v.iter().try_for_each(|x| check(field, *x))
+/// `x` within `d` (a lower bound of 0 for a magnitude or a noise density).
+pub(super) fn within(field: &'static str, d: &Domain, x: f64) -> Result<(), ConfigError> {
+    d.check(x)
+        .map(|_| ())
+        .map_err(|e| ConfigError::new(field, e.to_string()))
 }
 
-fn finite3(field: &'static str, v: &Vector3<f64>) -> Result<(), ConfigError> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ConfigError::new(
-            field,
-            format!("must be finite, got {v:?}"),
-        ))
+/// Every component of `v` within `d`.
+pub(super) fn each_within(
+    field: &'static str,
+    d: &Domain,
+    v: &Vector3<f64>,
+) -> Result<(), ConfigError> {
+    v.iter().try_for_each(|&x| within(field, d, x))
+}
+
+/// The domain of a noise term's magnitude: from 0 to `max`'s bound, since a 1-s
+/// sigma beyond the sensor's range is no sensor.
+const fn noise(max: &Domain) -> Domain {
+    Domain {
+        quantity: "noise",
+        min: 0.0,
+        why: "at most the sensor's range",
+        ..*max
     }
+}
+
+/// The domains of the gyro bias, accelerometer bias, gyro and accelerometer
+/// scale-factor noise terms (and their initial standard deviations).
+const SENSOR_NOISE: [Domain; 4] = [
+    noise(&domain::ANGULAR_RATE),
+    noise(&domain::SPECIFIC_FORCE),
+    noise(&domain::SCALE_FACTOR),
+    noise(&domain::SCALE_FACTOR),
+];
+
+/// Check every term of the IMU noise model.
+fn validate_noise(n: &ImuNoise) -> Result<(), ConfigError> {
+    let [rate, force, scale, _] = SENSOR_NOISE;
+    for (field, d, v) in [
+        ("filter.integration.noise.arw", &rate, &n.arw),
+        ("filter.integration.noise.vrw", &force, &n.vrw),
+        ("filter.integration.noise.gyro_bias", &rate, &n.gyro_bias),
+        ("filter.integration.noise.accel_bias", &force, &n.accel_bias),
+        (
+            "filter.integration.noise.gyro_bias_walk",
+            &rate,
+            &n.gyro_bias_walk,
+        ),
+        (
+            "filter.integration.noise.accel_bias_walk",
+            &force,
+            &n.accel_bias_walk,
+        ),
+        ("filter.integration.noise.gyro_scale", &scale, &n.gyro_scale),
+        (
+            "filter.integration.noise.accel_scale",
+            &scale,
+            &n.accel_scale,
+        ),
+    ] {
+        each_within(field, d, v)?;
+    }
+    for (field, tau) in [
+        ("filter.integration.noise.gyro_bias_tau", n.gyro_bias_tau),
+        ("filter.integration.noise.accel_bias_tau", n.accel_bias_tau),
+        ("filter.integration.noise.scale_tau", n.scale_tau),
+    ] {
+        // An infinite correlation time is a random walk.
+        if tau.is_nan() || tau <= 0.0 {
+            return Err(ConfigError::new(
+                field,
+                format!("must be positive, got {tau}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl SessionConfig {
@@ -376,35 +437,12 @@ impl FilterConfig {
     pub fn validate(&self) -> Result<(), ConfigError> {
         let c = &self.integration;
         let n = &c.noise;
-        for (field, v) in [
-            ("filter.integration.noise.arw", &n.arw),
-            ("filter.integration.noise.vrw", &n.vrw),
-            ("filter.integration.noise.gyro_bias", &n.gyro_bias),
-            ("filter.integration.noise.accel_bias", &n.accel_bias),
-            ("filter.integration.noise.gyro_bias_walk", &n.gyro_bias_walk),
-            (
-                "filter.integration.noise.accel_bias_walk",
-                &n.accel_bias_walk,
-            ),
-            ("filter.integration.noise.gyro_scale", &n.gyro_scale),
-            ("filter.integration.noise.accel_scale", &n.accel_scale),
-        ] {
-            each(field, v, non_negative)?;
-        }
-        for (field, tau) in [
-            ("filter.integration.noise.gyro_bias_tau", n.gyro_bias_tau),
-            ("filter.integration.noise.accel_bias_tau", n.accel_bias_tau),
-            ("filter.integration.noise.scale_tau", n.scale_tau),
-        ] {
-            // An infinite correlation time is a random walk.
-            if tau.is_nan() || tau <= 0.0 {
-                return Err(ConfigError::new(
-                    field,
-                    format!("must be positive, got {tau}"),
-                ));
-            }
-        }
-        finite3("filter.integration.lever_arm", &c.lever_arm)?;
+        validate_noise(n)?;
+        each_within(
+            "filter.integration.lever_arm",
+            &domain::LEVER_ARM,
+            &c.lever_arm,
+        )?;
         if let Gate::Level(a) = c.gate
             && !(a > 0.0 && a < 1.0)
         {
@@ -417,12 +455,28 @@ impl FilterConfig {
             "filter.integration.propagation_interval",
             c.propagation_interval,
         )?;
-        each("filter.integration.init_pos_std", &c.init_pos_std, positive)?;
-        each("filter.integration.init_vel_std", &c.init_vel_std, positive)?;
-        each("filter.integration.init_att_std", &c.init_att_std, positive)?;
+        for (field, d, v) in [
+            (
+                "filter.integration.init_pos_std",
+                &domain::POSITION_STD,
+                &c.init_pos_std,
+            ),
+            (
+                "filter.integration.init_vel_std",
+                &domain::VELOCITY_STD,
+                &c.init_vel_std,
+            ),
+            (
+                "filter.integration.init_att_std",
+                &domain::ANGLE_STD,
+                &c.init_att_std,
+            ),
+        ] {
+            each_within(field, d, v)?;
+        }
         if let Some(sd) = &c.init_sensor_std {
-            for v in sd {
-                each("filter.integration.init_sensor_std", v, non_negative)?;
+            for (v, d) in sd.iter().zip(&SENSOR_NOISE) {
+                each_within("filter.integration.init_sensor_std", d, v)?;
             }
         }
         if let Some(p) = &self.att_bias_cov {
@@ -439,7 +493,25 @@ impl FilterConfig {
             non_negative("filter.integration.baro", walk)?;
             positive("filter.baro_std", self.baro_std)?;
         }
-        let v = &self.vehicle;
+        self.vehicle.validate()
+    }
+}
+
+impl VehicleConfig {
+    /// Check every value of the vehicle aids (fields named from the session config).
+    fn validate(&self) -> Result<(), ConfigError> {
+        let v = self;
+        each_within(
+            "filter.vehicle.mount.lever",
+            &domain::LEVER_ARM,
+            &v.mount.lever,
+        )?;
+        if !v.mount.q_vb.coords.iter().all(|x| x.is_finite()) {
+            return Err(ConfigError::new(
+                "filter.vehicle.mount.q_vb",
+                "the mounting angles must be finite",
+            ));
+        }
         if let Some(r) = &v.rest {
             positive("filter.vehicle.rest.std", r.std)?;
             positive("filter.vehicle.rest.interval", r.interval)?;

@@ -213,6 +213,7 @@ impl<E: EarthModel> Session<E> {
     /// A session on `earth` that starts at `start` when the first sample arrives.
     pub fn new(earth: E, config: SessionConfig, start: Start) -> Result<Self, SessionError> {
         config.validate()?;
+        start.validate()?;
         Ok(Self {
             earth,
             start,

@@ -3,8 +3,10 @@
 //! alignment, for every front end.
 
 use super::FilterConfig;
+use super::config::{ConfigError, each_within, within};
 use crate::align::Alignment;
 use crate::align::in_motion::InMotionStart;
+use crate::domain;
 use crate::filter::{IntegrationConfig, SensorEstimates};
 use crate::nav::NavState;
 use nalgebra::{SMatrix, Vector3};
@@ -21,6 +23,45 @@ pub struct Start {
 }
 
 impl Start {
+    /// Checks the start against the physical domains ([`crate::domain`]): position,
+    /// velocity, a finite time and attitude, and sensor errors within what a sensor
+    /// reads. The error names the field as `start.…`.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let s = &self.state;
+        within("start.state.pos.lat", &domain::LATITUDE, s.pos.lat)?;
+        within("start.state.pos.lon", &domain::LONGITUDE, s.pos.lon)?;
+        within("start.state.pos.h", &domain::HEIGHT, s.pos.h)?;
+        each_within("start.state.v_n", &domain::SPEED, &s.v_n)?;
+        if !(s.t.is_finite() && s.q_bn.coords.iter().all(|x| x.is_finite())) {
+            return Err(ConfigError::new(
+                "start.state.q_bn",
+                "the time and the attitude must be finite",
+            ));
+        }
+        let e = &self.estimates;
+        each_within(
+            "start.estimates.gyro_bias",
+            &domain::ANGULAR_RATE_COMPONENT,
+            &e.gyro_bias,
+        )?;
+        each_within(
+            "start.estimates.accel_bias",
+            &domain::SPECIFIC_FORCE_COMPONENT,
+            &e.accel_bias,
+        )?;
+        each_within(
+            "start.estimates.gyro_scale",
+            &domain::SCALE_FACTOR,
+            &e.gyro_scale,
+        )?;
+        each_within(
+            "start.estimates.accel_scale",
+            &domain::SCALE_FACTOR,
+            &e.accel_scale,
+        )?;
+        Ok(())
+    }
+
     /// At `state` with no sensor error known.
     pub fn at(state: NavState) -> Self {
         Self {
