@@ -6,7 +6,7 @@ use crate::options::{EarthChoice, GradeChoice};
 use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
-use schuler::align::{AlignConfig, Alignment, HeadingSource, MotionReport, align};
+use schuler::align::{AlignConfig, AlignError, Alignment, HeadingSource, MotionReport, align};
 use schuler::earth::{Geodetic, Sphere, Wgs84};
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
@@ -147,7 +147,13 @@ pub fn align_on(
             cfg,
         ),
     };
-    r.map_err(anyhow::Error::new)
+    r.map_err(|e| match e {
+        AlignError::NotEnoughData { .. } => anyhow::anyhow!(
+            "{e}: shorten the stages with --coarse and --fine (their sum at most the log's \
+             span), or give a longer log"
+        ),
+        other => anyhow::Error::new(other),
+    })
 }
 
 fn deg3(v: &Vector3<f64>) -> [f64; 3] {
@@ -205,7 +211,8 @@ fn write_biases(s: &mut String, a: &Alignment) {
     let unobservable = unobservable_biases(a);
     let _ = writeln!(
         s,
-        "not observable at rest (estimates stay at their prior): {}",
+        "not observable at rest (standard deviation near its prior; the estimate moves \
+         only with the states it is correlated with): {}",
         if unobservable.is_empty() {
             "none".to_string()
         } else {

@@ -472,7 +472,12 @@ fn label(v: f64, all: &[f64]) -> String {
         let digits = ((big / step).log10().ceil().max(1.0) as usize).min(6);
         return format!("{:.*e}", digits.saturating_sub(1), v);
     }
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    // A step of 0 (a constant series) needs no decimals; no f64 needs more than 17.
+    let decimals = if step > 0.0 {
+        (-step.log10().floor()).clamp(0.0, 17.0) as usize
+    } else {
+        0
+    };
     format!("{v:.decimals$}")
 }
 
@@ -530,6 +535,14 @@ fn thin(points: &[(f64, f64)], x0: f64, x1: f64, columns: usize) -> Vec<Vec<(f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A constant series gives a tick step of 0: its labels need no decimals (this
+    /// formatted with `usize::MAX` decimals and panicked).
+    #[test]
+    fn labels_of_a_constant_series() {
+        assert_eq!(label(1000.0, &[1000.0, 1000.0]), "1000");
+        assert_eq!(label(-1000.0, &[-1000.0]), "-1000");
+    }
 
     #[test]
     fn ticks_are_round_and_cover_the_range() {

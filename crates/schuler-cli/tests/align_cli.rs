@@ -186,5 +186,7 @@ fn polar_gyrocompassing_is_refused_and_bad_options_name_the_flag() {
         .args(["--pos", "45,10,100"])
         .assert()
         .failure()
-        .stderr(predicate::str::contains("needed").or(predicate::str::contains("need")));
+        .stderr(predicate::str::contains("the alignment stages need").and(
+            predicate::str::contains("shorten the stages with --coarse and --fine"),
+        ));
 }

@@ -203,3 +203,22 @@ fn leveled_ins_stays_put_through_an_acceleration() {
     let bound = 2.0 * 100.0f64.powi(2) * 1e-3 / 9.81f64.powi(2);
     assert!(peak <= 1.01 * bound, "{peak} m vs {bound} m");
 }
+
+/// Issue "Reliability"'s reproducer: an initial position error of exactly 1 km on the
+/// INS and SINS systems panicked while labelling a plot whose series is constant (a
+/// tick step of 0). The run succeeds and writes its plots.
+#[test]
+fn a_constant_error_series_plots_without_panicking() {
+    for system in ["ins", "sins"] {
+        let dir = tempfile::tempdir().expect("tempdir");
+        channel(dir.path(), &["--system", system, "--init-pos-error=1km"]).success();
+        let svgs = std::fs::read_dir(dir.path())
+            .expect("out dir")
+            .filter(|e| {
+                e.as_ref()
+                    .is_ok_and(|e| e.path().extension().is_some_and(|x| x == "svg"))
+            })
+            .count();
+        assert!(svgs > 0, "{system}: no plot written");
+    }
+}

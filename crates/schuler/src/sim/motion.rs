@@ -21,6 +21,7 @@
 
 use super::jet::{self, Jet, Scalar};
 use super::spline::{Knot, SplineTrajectory};
+use crate::domain::{DomainError, HEIGHT, SPEED};
 use crate::earth::{EarthModel, Geodetic};
 use crate::rotation::Euler;
 use nalgebra::Vector3;
@@ -229,7 +230,36 @@ pub enum MotionError {
     /// No pieces.
     #[error("a motion needs at least one piece")]
     Empty,
+    /// The motion would last longer than the builder's limit
+    /// ([`MAX_MOTION_DURATION`] unless set otherwise).
+    #[error(
+        "piece {index}: the motion would last {total_s:.3e} s, beyond the limit of {limit_s} s \
+         (its knots, 100 a second, take 16 kB of memory per second)"
+    )]
+    TooLong {
+        /// Piece index.
+        index: usize,
+        /// The motion's duration with this piece [s].
+        total_s: f64,
+        /// The limit [s].
+        limit_s: f64,
+    },
+    /// The motion's height or speed left its physical domain.
+    #[error("piece {index}: at t = {t} s the motion's {reason}")]
+    Leaves {
+        /// Piece index.
+        index: usize,
+        /// Time [s].
+        t: f64,
+        /// Which domain, and the value (boxed: errors stay small on the happy path).
+        reason: Box<DomainError>,
+    },
 }
+
+/// Longest motion a builder integrates by default [s]: a day, whose knots take 1.4 GB
+/// (152 + 8 bytes at 100 Hz); longer runs are soak tests, which repeat a shorter
+/// motion ([`MotionBuilder::with_max_duration`] lifts the limit).
+pub const MAX_MOTION_DURATION: f64 = 24.0 * 3600.0;
 
 /// Integrates pieces one after another, so a maneuver can be planned from the state
 /// the previous ones reached (current speed, height, bank).
@@ -242,6 +272,8 @@ pub struct MotionBuilder<E: EarthModel> {
     pieces: usize,
     /// Who hears of the knots as they are made ([`MotionBuilder::feed`]).
     feed: FeedSlot,
+    /// Start time and the longest duration allowed [s].
+    span: (f64, f64),
 }
 
 /// A builder's [`KnotFeed`], if any. A clone (a trial integration) has none: its
@@ -291,7 +323,14 @@ impl<E: EarthModel> MotionBuilder<E> {
             knots: Vec::new(),
             pieces: 0,
             feed: FeedSlot::default(),
+            span: (start.t, MAX_MOTION_DURATION),
         }
+    }
+
+    /// Allow motions up to `seconds` long instead of [`MAX_MOTION_DURATION`].
+    pub fn with_max_duration(mut self, seconds: f64) -> Self {
+        self.span.1 = seconds;
+        self
     }
 
     /// Send every knot from now on to `feed` as well.
@@ -324,6 +363,14 @@ impl<E: EarthModel> MotionBuilder<E> {
                 duration: piece.duration,
             });
         }
+        let total_s = self.t + piece.duration - self.span.0;
+        if total_s > self.span.1 {
+            return Err(MotionError::TooLong {
+                index,
+                total_s,
+                limit_s: self.span.1,
+            });
+        }
         let n = (piece.duration / MAX_STEP).ceil().max(1.0) as usize;
         let h = piece.duration / n as f64;
         let mut x = self.x;
@@ -345,6 +392,14 @@ impl<E: EarthModel> MotionBuilder<E> {
                 });
             }
             let tau1 = (k + 1) as f64 * h;
+            let speed = (x[6] * x[6] + x[7] * x[7] + x[8] * x[8]).sqrt();
+            if let Err(reason) = HEIGHT.check(x[2]).and_then(|_| SPEED.check(speed)) {
+                return Err(MotionError::Leaves {
+                    index,
+                    t: self.t + tau1,
+                    reason: Box::new(reason),
+                });
+            }
             d1 = derivative_value(&self.earth, piece, tau1, &x);
             knots.push(knot(&self.earth, piece, self.t + tau1, tau1, &x, &d1));
             if let Some(feed) = self.feed.0.as_mut()
@@ -458,6 +513,54 @@ mod tests {
             v_n: Vector3::new(20.0, 0.0, 0.0),
             attitude: Euler::default(),
         }
+    }
+
+    /// Issue "Reliability"'s reproducers, which aborted on allocation or ran for ever:
+    /// a hold of 1e9 s (and 1e308 s) is refused before any knot is made; speeding up
+    /// to 1e8 m/s stops where the speed passes the escape velocity, naming the time.
+    #[test]
+    fn absurd_motions_are_refused_not_allocated() {
+        for duration in [1e9, 1e308] {
+            let mut b = MotionBuilder::new(Wgs84, &start());
+            let e = b.push(&Piece::hold(duration)).expect_err("too long");
+            assert!(matches!(e, MotionError::TooLong { index: 0, .. }), "{e}");
+            assert!(b.knots.is_empty());
+        }
+        let mut b = MotionBuilder::new(Wgs84, &start());
+        let fast = Piece {
+            d_vel: [1e8, 0.0, 0.0],
+            shape: Shape::Bump,
+            ..Piece::hold(1000.0)
+        };
+        // The bump's integral 10x³ - 15x⁴ + 6x⁵ brings 20 m/s to 12 km/s at x*.
+        let gained = |x: f64| 1e8 * x.powi(3) * (10.0 - 15.0 * x + 6.0 * x * x);
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if 20.0 + gained(mid) < SPEED.max {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        match b.push(&fast).expect_err("too fast") {
+            MotionError::Leaves {
+                index: 0,
+                t,
+                reason,
+            } => {
+                // Checked at the end of each step: within one step after the crossing.
+                let crossing = 1000.0 * lo;
+                assert!(
+                    t >= crossing && t <= crossing + MAX_STEP,
+                    "{t} vs {crossing}"
+                );
+                assert_eq!(reason.domain, SPEED);
+            }
+            other => panic!("{other}"),
+        }
+        let b = MotionBuilder::new(Wgs84, &start()).with_max_duration(2e9);
+        assert_eq!(b.span.1, 2e9);
     }
 
     /// A piece changes Euler angles and body speed by exactly its totals (RK4 on a
