@@ -64,6 +64,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         earth: EarthChoice::Wgs84,
         week: 2200,
         mechanization: Default::default(),
+        out_bag: None,
     };
     let aiding = Aiding {
         fixes,
