@@ -7,7 +7,7 @@ Inputs (in SIM, a `schuler simulate --out` directory):
   imu.txt   t, dtheta_xyz [rad], dvel_xyz [m/s] over (t_prev, t], FRD axes
   gnss.csv  t, lat, lon [deg], h [m], std N E D [m], vn ve vd [m/s], their std
   baro.csv  t, h [m]            (optional)
-  ODOMETER  t speed [m/s] rows  (optional, --odometer)
+  truth.nav week sow lat lon h vn ve vd roll pitch yaw (with --odometer-rate)
 
 Messages (REP 103 body axes FLU, REP 105 world ENU):
   /imu/data  sensor_msgs/msg/Imu: angular_velocity = FLU(dtheta / dt),
@@ -20,7 +20,9 @@ Messages (REP 103 body axes FLU, REP 105 world ENU):
   /gnss/vel  geometry_msgs/msg/TwistWithCovarianceStamped, ENU (ve, vn, -vd)
   /baro      sensor_msgs/msg/FluidPressure: p = p0 (1 - L h / T0)^(g0 M / (R L)),
              the ISA troposphere with the U.S. Standard Atmosphere 1976 constants
-  /odom      nav_msgs/msg/Odometry, twist.twist.linear.x = speed
+  /odom      nav_msgs/msg/Odometry, twist.twist.linear.x = the true speed
+             sqrt(vn^2 + ve^2 + vd^2) of truth.nav at the times that are multiples
+             of 1/--odometer-rate (within 1e-6 of a period)
 
 Stamps: sec = floor(t), nanosec = the rest in ns; log time = stamp + --latency
 (GNSS, baro, odometry arrive late, as recorded on a robot), messages in log-time
@@ -173,13 +175,16 @@ def baro_messages(path, latency_ns):
                 "header": h, "fluid_pressure": pressure(h_m), "variance": 0.0}
 
 
-def odometry_messages(path, latency_ns):
+def odometry_messages(path, rate_hz, latency_ns):
     with open(path) as f:
         for line in f:
-            fields = line.replace(",", " ").split()
-            if not fields or not fields[0][0].isdigit():
+            fields = [float(x) for x in line.split()]
+            if not fields:
                 continue
-            t, speed = float(fields[0]), float(fields[1])
+            t, (vn, ve, vd) = fields[1], fields[5:8]
+            if abs(t * rate_hz - round(t * rate_hz)) > 1e-6:
+                continue
+            speed = math.sqrt(vn * vn + ve * ve + vd * vd)
             ns, h = header(t, "odom")
             yield ns + latency_ns, "/odom", {
                 "header": h,
@@ -197,7 +202,8 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("sim", help="a `schuler simulate --out` directory")
     p.add_argument("out", help="the .mcap file to write")
-    p.add_argument("--odometer", help="odometer rows `t speed` (or t,speed CSV)")
+    p.add_argument("--odometer-rate", type=float,
+                   help="write /odom at this rate [Hz] from truth.nav's speed")
     p.add_argument("--latency", type=float, default=0.05,
                    help="log time after the stamp of GNSS, baro, odometry [s]")
     p.add_argument("--compression", choices=["zstd", "lz4", "none"], default="zstd")
@@ -211,8 +217,8 @@ def main():
                gnss_messages(f"{a.sim}/gnss.csv", latency_ns)]
     if not a.no_baro:
         streams.append(baro_messages(f"{a.sim}/baro.csv", latency_ns))
-    if a.odometer:
-        streams.append(odometry_messages(a.odometer, latency_ns))
+    if a.odometer_rate:
+        streams.append(odometry_messages(f"{a.sim}/truth.nav", a.odometer_rate, latency_ns))
     messages = [m for s in streams for m in s]
     # Log-time order; ties keep the order above (IMU first), as sorted() is stable.
     messages.sort(key=lambda m: m[0])

@@ -161,7 +161,7 @@ impl BagStream {
         let file =
             File::open(&path).map_err(|e| BagError::file(&path, format!("cannot open: {e}")))?;
         let options = LinearReaderOptions::default()
-            .with_validate_chunk_crcs(true)
+            .with_prevalidate_chunk_crcs(true)
             .with_record_length_limit(1 << 30);
         // Channel and schema ids are per file.
         self.schemas.clear();

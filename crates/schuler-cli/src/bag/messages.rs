@@ -109,6 +109,24 @@ impl Imu {
     }
 }
 
+impl Imu {
+    /// Encodes the message (orientation unknown: identity, covariance `[-1, 0, …]`),
+    /// for test and benchmark bags.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        self.header.write(&mut w);
+        w.f64s(&[0.0, 0.0, 0.0, 1.0]);
+        let mut unknown = [0.0; 9];
+        unknown[0] = -1.0;
+        w.f64s(&unknown);
+        w.f64s(&self.angular_velocity);
+        w.f64s(&self.angular_velocity_covariance);
+        w.f64s(&self.linear_acceleration);
+        w.f64s(&self.linear_acceleration_covariance);
+        w.finish()
+    }
+}
+
 /// `sensor_msgs/msg/NavSatFix`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NavSatFix {
@@ -351,6 +369,19 @@ pub mod definitions {
         )
     }
 
+    /// `sensor_msgs/msg/Imu`.
+    pub fn imu() -> String {
+        with_deps(
+            "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance\n",
+            &[
+                HEADER,
+                TIME,
+                "MSG: geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n",
+                "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n",
+            ],
+        )
+    }
+
     /// `geometry_msgs/msg/Vector3Stamped`.
     pub fn vector3_stamped() -> String {
         with_deps(
@@ -402,6 +433,14 @@ mod tests {
             twist_covariance: cov,
         };
         assert_eq!(Odometry::decode(&odo.encode()), Ok(odo));
+        let imu = Imu {
+            header: header(),
+            angular_velocity: [0.1, -0.2, 0.3],
+            angular_velocity_covariance: [1e-6; 9],
+            linear_acceleration: [0.5, 0.0, 9.8],
+            linear_acceleration_covariance: [1e-4; 9],
+        };
+        assert_eq!(Imu::decode(&imu.encode()), Ok(imu));
         assert!((header().seconds() - 345_600.005).abs() < 1e-10);
     }
 
