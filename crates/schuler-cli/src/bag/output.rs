@@ -176,7 +176,7 @@ impl ResultBag {
             status: 0,
             service: 0,
             latitude: pos.lat.to_degrees(),
-            longitude: (pos.lon.to_degrees() + 180.0).rem_euclid(360.0) - 180.0,
+            longitude: wrap_degrees(pos.lon.to_degrees()),
             altitude: pos.h,
             position_covariance: fix_cov,
             position_covariance_type: if e.filter.is_some() { 3 } else { 0 },
@@ -200,6 +200,15 @@ impl ResultBag {
             .finish()
             .map_err(|e| BagError::file(&self.path, e.to_string()))?;
         Ok(())
+    }
+}
+
+/// A longitude [deg] in [−180, 180]; one already there unchanged (bit for bit).
+fn wrap_degrees(lon: f64) -> f64 {
+    if (-180.0..=180.0).contains(&lon) {
+        lon
+    } else {
+        (lon + 180.0).rem_euclid(360.0) - 180.0
     }
 }
 
