@@ -220,6 +220,43 @@ fn f64s(v: &serde_json::Value) -> Vec<f64> {
         .collect()
 }
 
+/// Each topic of the result bag: its type, CDR, one message per nav.csv row, stamped
+/// at the row's time and logged at the same instant, in its frame.
+fn check_stamps_and_frames(msgs: &[serde_json::Value], rows: &[Vec<f64>]) {
+    let on = |topic: &str| -> Vec<&serde_json::Value> {
+        msgs.iter().filter(|m| m["topic"] == topic).collect()
+    };
+    for (topic, ty) in [
+        ("/schuler/odometry", "nav_msgs/msg/Odometry"),
+        ("/schuler/fix", "sensor_msgs/msg/NavSatFix"),
+        ("/schuler/gyro_bias", "geometry_msgs/msg/Vector3Stamped"),
+        ("/schuler/accel_bias", "geometry_msgs/msg/Vector3Stamped"),
+    ] {
+        let m = on(topic);
+        assert_eq!(m.len(), rows.len(), "{topic}");
+        for (x, r) in m.iter().zip(rows) {
+            assert_eq!(
+                (x["type"].as_str(), x["encoding"].as_str()),
+                (Some(ty), Some("cdr"))
+            );
+            let t = x["sec"].as_f64().expect("sec") + x["nanosec"].as_f64().expect("ns") * 1e-9;
+            assert!((t - r[0]).abs() <= 1e-6, "{topic} stamp {t} vs {}", r[0]);
+            let log = x["log_time"].as_u64().expect("log time");
+            assert_eq!(
+                log,
+                x["sec"].as_u64().expect("sec") * 1_000_000_000
+                    + x["nanosec"].as_u64().expect("ns")
+            );
+            let frame = if topic == "/schuler/odometry" {
+                "map"
+            } else {
+                "base_link"
+            };
+            assert_eq!(x["frame_id"], frame, "{topic}");
+        }
+    }
+}
+
 /// `--out-bag` as another implementation reads it: four topics of the named types,
 /// CDR, one message per nav.csv epoch each, stamped (sec, nanosec) at the epoch's time
 /// and logged at the same instant; frames map/base_link; the fix at nav.csv's position
@@ -247,6 +284,7 @@ fn the_result_bag_reads_back_in_python() {
         .collect();
     let msgs = read_with_python(&py, &result);
     assert_eq!(msgs.len(), 4 * rows.len());
+    check_stamps_and_frames(&msgs, &rows);
     let on = |topic: &str| -> Vec<&serde_json::Value> {
         msgs.iter().filter(|m| m["topic"] == topic).collect()
     };
@@ -254,35 +292,6 @@ fn the_result_bag_reads_back_in_python() {
     let (sp, cp) = rows[0][1].to_radians().sin_cos();
     let (sl, cl) = rows[0][2].to_radians().sin_cos();
     let c0 = Matrix3::new(-sl, cl, 0.0, -sp * cl, -sp * sl, cp, cp * cl, cp * sl, sp);
-    for (topic, ty) in [
-        ("/schuler/odometry", "nav_msgs/msg/Odometry"),
-        ("/schuler/fix", "sensor_msgs/msg/NavSatFix"),
-        ("/schuler/gyro_bias", "geometry_msgs/msg/Vector3Stamped"),
-        ("/schuler/accel_bias", "geometry_msgs/msg/Vector3Stamped"),
-    ] {
-        let m = on(topic);
-        assert_eq!(m.len(), rows.len(), "{topic}");
-        for (x, r) in m.iter().zip(&rows) {
-            assert_eq!(
-                (x["type"].as_str(), x["encoding"].as_str()),
-                (Some(ty), Some("cdr"))
-            );
-            let t = x["sec"].as_f64().expect("sec") + x["nanosec"].as_f64().expect("ns") * 1e-9;
-            assert!((t - r[0]).abs() <= 1e-6, "{topic} stamp {t} vs {}", r[0]);
-            let log = x["log_time"].as_u64().expect("log time");
-            assert_eq!(
-                log,
-                x["sec"].as_u64().expect("sec") * 1_000_000_000
-                    + x["nanosec"].as_u64().expect("ns")
-            );
-            let frame = if topic == "/schuler/odometry" {
-                "map"
-            } else {
-                "base_link"
-            };
-            assert_eq!(x["frame_id"], frame, "{topic}");
-        }
-    }
     for (x, r) in on("/schuler/fix").iter().zip(&rows) {
         assert!((x["latitude"].as_f64().expect("lat") - r[1]).abs() <= 1e-11);
         assert!((x["longitude"].as_f64().expect("lon") - r[2]).abs() <= 1e-11);

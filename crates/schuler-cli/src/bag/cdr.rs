@@ -163,11 +163,30 @@ impl<'a> CdrReader<'a> {
         Ok(out)
     }
 
-    /// Skips `n` `float64`s (a fixed array not used).
+    /// Skips `n` `float64`s (a fixed array not used), with one bounds check.
     pub fn skip_f64s(&mut self, n: usize, field: &str) -> Result<(), CdrError> {
-        for _ in 0..n {
-            self.f64(field)?;
+        let start = self.pos.next_multiple_of(8);
+        self.skip_to(start + 8 * n, field)
+    }
+
+    /// Skips a `string` without reading it.
+    pub fn skip_string(&mut self, field: &str) -> Result<(), CdrError> {
+        let n = self.u32(field)? as usize;
+        self.skip_to(self.pos.saturating_add(n), field)
+    }
+
+    /// Moves to body byte `end`, which must be inside the payload.
+    fn skip_to(&mut self, end: usize, field: &str) -> Result<(), CdrError> {
+        if end > self.body.len() {
+            return Err(CdrError {
+                field: field.to_owned(),
+                reason: format!(
+                    "payload ends at byte {} of its body, {end} bytes needed",
+                    self.body.len()
+                ),
+            });
         }
+        self.pos = end;
         Ok(())
     }
 }

@@ -8,7 +8,7 @@
 use super::BagError;
 use mcap::records::{MessageHeader, Record, op};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -32,6 +32,9 @@ pub struct Topic {
 pub struct Message<'a> {
     /// The channel.
     pub topic: &'a Topic,
+    /// The topic's place among the bag's topics, in order of their channel records
+    /// (the same across the files of a rosbag2 directory).
+    pub topic_index: usize,
     /// 1-based index of the message within its topic, in file order.
     pub index: u64,
     /// MCAP log time [ns].
@@ -101,16 +104,109 @@ fn rosbag2_files(meta: &Path, text: &str) -> Result<Vec<String>, BagError> {
     Ok(info.relative_file_paths)
 }
 
+/// The schemas, channels and topics seen so far, and the last message read.
+#[derive(Default)]
+struct Catalog {
+    schemas: HashMap<u16, (String, String)>,
+    /// This file's channel ids to places in `topics`.
+    channels: HashMap<u16, usize>,
+    /// Every topic seen, with its message count so far.
+    topics: Vec<(Arc<Topic>, u64)>,
+    /// The last message read: its topic's place and index, for errors between
+    /// messages.
+    last: Option<(usize, u64)>,
+}
+
+impl Catalog {
+    /// An error in the container of `file` (placed after the last message read).
+    fn container_error(&self, file: &Path, reason: impl std::fmt::Display) -> BagError {
+        let after = match self.last {
+            Some((place, index)) => {
+                format!(
+                    "after message {index} of topic {}",
+                    self.topics[place].0.name
+                )
+            }
+            None => "before the first message".to_owned(),
+        };
+        BagError::file(file, format!("{after}: {reason}"))
+    }
+
+    /// Takes in record `opcode` of `file`: schemas and channels are remembered, a
+    /// message is counted and handed to `f`; `Ok(None)` for any other record.
+    fn record<R>(
+        &mut self,
+        file: &Path,
+        opcode: u8,
+        data: &[u8],
+        f: &mut impl FnMut(Message) -> Result<R, BagError>,
+    ) -> Result<Option<R>, BagError> {
+        if !matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE) {
+            return Ok(None);
+        }
+        let record = mcap::parse_record(opcode, data).map_err(|e| self.container_error(file, e))?;
+        match record {
+            Record::Schema { header, .. } => {
+                self.schemas
+                    .insert(header.id, (header.name, header.encoding));
+            }
+            Record::Channel(c) => {
+                let topic = channel_topic(&self.schemas, &c)
+                    .map_err(|reason| BagError::topic(file, &c.topic, 0, None, reason))?;
+                let place = match self.topics.iter().position(|(t, _)| **t == topic) {
+                    Some(place) => place,
+                    None => {
+                        self.topics.push((Arc::new(topic), 0));
+                        self.topics.len() - 1
+                    }
+                };
+                self.channels.insert(c.id, place);
+            }
+            Record::Message { header, data } => {
+                let MessageHeader {
+                    channel_id,
+                    log_time,
+                    ..
+                } = header;
+                let Some(&place) = self.channels.get(&channel_id) else {
+                    return Err(self.container_error(
+                        file,
+                        format!(
+                            "a message on channel {channel_id}, which no channel record defines"
+                        ),
+                    ));
+                };
+                let (topic, count) = &mut self.topics[place];
+                *count += 1;
+                self.last = Some((place, *count));
+                return f(Message {
+                    topic,
+                    topic_index: place,
+                    index: *count,
+                    log_time,
+                    data: &data,
+                })
+                .map(Some);
+            }
+            _ => {}
+        }
+        Ok(None)
+    }
+}
+
+/// One open `.mcap` file and its streaming reader.
+struct OpenFile {
+    path: PathBuf,
+    file: File,
+    reader: LinearReader,
+}
+
 /// Reads every message of a bag in file order.
 pub struct BagStream {
     files: Vec<PathBuf>,
     next_file: usize,
-    open: Option<(PathBuf, File, LinearReader)>,
-    schemas: HashMap<u16, (String, String)>,
-    channels: HashMap<u16, Arc<Topic>>,
-    counts: BTreeMap<String, u64>,
-    /// The last message read: its topic and index, for errors between messages.
-    last: Option<(String, u64)>,
+    open: Option<OpenFile>,
+    catalog: Catalog,
     bytes: u64,
 }
 
@@ -121,10 +217,7 @@ impl BagStream {
             files: files_of(path)?,
             next_file: 0,
             open: None,
-            schemas: HashMap::new(),
-            channels: HashMap::new(),
-            counts: BTreeMap::new(),
-            last: None,
+            catalog: Catalog::default(),
             bytes: 0,
         })
     }
@@ -143,15 +236,6 @@ impl BagStream {
             .sum()
     }
 
-    /// An error in the container (file, position after the last message, reason).
-    fn container_error(&self, file: &Path, reason: String) -> BagError {
-        let after = match &self.last {
-            Some((topic, index)) => format!("after message {index} of topic {topic}"),
-            None => "before the first message".to_owned(),
-        };
-        BagError::file(file, format!("{after}: {reason}"))
-    }
-
     /// Opens the next file; `false` when none is left.
     fn open_next(&mut self) -> Result<bool, BagError> {
         let Some(path) = self.files.get(self.next_file).cloned() else {
@@ -160,17 +244,23 @@ impl BagStream {
         self.next_file += 1;
         let file =
             File::open(&path).map_err(|e| BagError::file(&path, format!("cannot open: {e}")))?;
+        // Every chunk's CRC is checked before any of its messages is used.
         let options = LinearReaderOptions::default()
             .with_prevalidate_chunk_crcs(true)
             .with_record_length_limit(1 << 30);
         // Channel and schema ids are per file.
-        self.schemas.clear();
-        self.channels.clear();
-        self.open = Some((path, file, LinearReader::new_with_options(options)));
+        self.catalog.schemas.clear();
+        self.catalog.channels.clear();
+        self.open = Some(OpenFile {
+            path,
+            file,
+            reader: LinearReader::new_with_options(options),
+        });
         Ok(true)
     }
 
-    /// The next message, handed to `f`; `Ok(None)` at the end of the bag.
+    /// The next message, handed to `f`; `Ok(None)` at the end of the bag. After an
+    /// error the stream ends.
     pub fn next_with<R>(
         &mut self,
         mut f: impl FnMut(Message) -> Result<R, BagError>,
@@ -179,90 +269,35 @@ impl BagStream {
             if self.open.is_none() && !self.open_next()? {
                 return Ok(None);
             }
-            let Some((path, file, reader)) = self.open.as_mut() else {
+            let Some(OpenFile { path, file, reader }) = self.open.as_mut() else {
                 continue;
             };
-            let event = match reader.next_event() {
-                None => {
-                    self.open = None;
-                    continue;
+            let result = match reader.next_event() {
+                None => Ok(None),
+                Some(Err(e)) => Err(self.catalog.container_error(path, e)),
+                Some(Ok(LinearReadEvent::ReadRequest(n))) => match file.read(reader.insert(n)) {
+                    Ok(k) => {
+                        reader.notify_read(k);
+                        self.bytes += k as u64;
+                        continue;
+                    }
+                    Err(e) => Err(self.catalog.container_error(path, e)),
+                },
+                Some(Ok(LinearReadEvent::Record { opcode, data })) => {
+                    match self.catalog.record(path, opcode, data, &mut f) {
+                        Ok(None) => continue,
+                        other => other,
+                    }
                 }
-                Some(Err(e)) => {
-                    let path = path.clone();
+            };
+            match result {
+                Ok(Some(r)) => return Ok(Some(r)),
+                Ok(None) => self.open = None,
+                Err(e) => {
                     self.open = None;
                     self.next_file = self.files.len();
-                    return Err(self.container_error(&path, e.to_string()));
+                    return Err(e);
                 }
-                Some(Ok(event)) => event,
-            };
-            let (opcode, data) = match event {
-                LinearReadEvent::ReadRequest(n) => {
-                    let read = file.read(reader.insert(n));
-                    match read {
-                        Ok(k) => {
-                            reader.notify_read(k);
-                            self.bytes += k as u64;
-                        }
-                        Err(e) => {
-                            let path = path.clone();
-                            return Err(self.container_error(&path, e.to_string()));
-                        }
-                    }
-                    continue;
-                }
-                LinearReadEvent::Record { opcode, data } => (opcode, data),
-            };
-            if !matches!(opcode, op::SCHEMA | op::CHANNEL | op::MESSAGE) {
-                continue;
-            }
-            let record = match mcap::parse_record(opcode, data) {
-                Ok(r) => r,
-                Err(e) => {
-                    let path = path.clone();
-                    return Err(self.container_error(&path, e.to_string()));
-                }
-            };
-            match record {
-                Record::Schema { header, .. } => {
-                    self.schemas
-                        .insert(header.id, (header.name, header.encoding));
-                }
-                Record::Channel(c) => {
-                    let topic = channel_topic(&self.schemas, &c)
-                        .map_err(|reason| BagError::topic(path, &c.topic, 0, None, reason))?;
-                    self.channels.insert(c.id, Arc::new(topic));
-                }
-                Record::Message { header, data } => {
-                    let MessageHeader {
-                        channel_id,
-                        log_time,
-                        ..
-                    } = header;
-                    let Some(topic) = self.channels.get(&channel_id) else {
-                        let path = path.clone();
-                        return Err(self.container_error(
-                            &path,
-                            format!(
-                                "a message on channel {channel_id}, which no channel record defines"
-                            ),
-                        ));
-                    };
-                    let count = self.counts.entry(topic.name.clone()).or_insert(0);
-                    *count += 1;
-                    let index = *count;
-                    match &mut self.last {
-                        Some((name, i)) if *name == topic.name => *i = index,
-                        last => *last = Some((topic.name.clone(), index)),
-                    }
-                    return f(Message {
-                        topic,
-                        index,
-                        log_time,
-                        data: &data,
-                    })
-                    .map(Some);
-                }
-                _ => {}
             }
         }
     }

@@ -37,23 +37,31 @@ pub fn scan(
     mut visit: impl FnMut(&Message) -> Result<(), BagError>,
 ) -> Result<Vec<TopicSummary>, BagError> {
     let mut stream = BagStream::open(path)?;
-    let mut topics: Vec<TopicSummary> = Vec::new();
+    let mut order: Vec<usize> = Vec::new();
+    // By the stream's topic places; a topic whose channel has no message stays None.
+    let mut places: Vec<Option<TopicSummary>> = Vec::new();
     while let Some(()) = stream.next_with(|m| {
-        match topics.iter_mut().find(|s| s.topic.name == m.topic.name) {
+        if places.len() <= m.topic_index {
+            places.resize(m.topic_index + 1, None);
+        }
+        match &mut places[m.topic_index] {
             Some(s) => {
                 s.count += 1;
                 s.log_span_ns.0 = s.log_span_ns.0.min(m.log_time);
                 s.log_span_ns.1 = s.log_span_ns.1.max(m.log_time);
             }
-            None => topics.push(TopicSummary {
-                topic: m.topic.clone(),
-                count: 1,
-                log_span_ns: (m.log_time, m.log_time),
-            }),
+            empty => {
+                *empty = Some(TopicSummary {
+                    topic: m.topic.clone(),
+                    count: 1,
+                    log_span_ns: (m.log_time, m.log_time),
+                });
+                order.push(m.topic_index);
+            }
         }
         visit(&m)
     })? {}
-    Ok(topics)
+    Ok(order.into_iter().filter_map(|p| places[p].take()).collect())
 }
 
 /// The table `schuler bag info` prints: one line per topic.

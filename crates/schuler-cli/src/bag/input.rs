@@ -26,7 +26,7 @@ use super::BagError;
 use super::container::{BagStream, Message, Topic};
 use super::info::{TopicSummary, scan};
 use super::messages::{
-    FLUID_PRESSURE, FluidPressure, IMU, Imu, NAV_SAT_FIX, NavSatFix, ODOMETRY, Odometry,
+    FLUID_PRESSURE, FluidPressure, IMU, Imu, ImuMotion, NAV_SAT_FIX, NavSatFix, ODOMETRY, Odometry,
     STATUS_NO_FIX, TWIST, TwistStamped,
 };
 use nalgebra::{Matrix3, Vector3};
@@ -315,14 +315,28 @@ fn list(names: &[&str]) -> String {
 /// The first pass over the bag at `path`: topics, the chosen ones, the IMU's
 /// interval and noise, the aids.
 pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> {
-    let mut gathered: HashMap<String, Gathered> = HashMap::new();
+    let mut by_place: Vec<Option<Gathered>> = Vec::new();
     let known = Kind::ALL.map(Kind::type_name);
+    let mut names: HashMap<usize, String> = HashMap::new();
     let topics = scan(path, |m| {
         if known.contains(&m.topic.type_name.as_str()) {
-            gather(path, m, gathered.entry(m.topic.name.clone()).or_default());
+            if by_place.len() <= m.topic_index {
+                by_place.resize_with(m.topic_index + 1, || None);
+            }
+            let g = by_place[m.topic_index].get_or_insert_with(|| {
+                names.insert(m.topic_index, m.topic.name.clone());
+                Gathered::default()
+            });
+            gather(path, m, g);
         }
         Ok(())
     })?;
+    let mut gathered: HashMap<String, Gathered> = HashMap::new();
+    for (place, g) in by_place.into_iter().enumerate() {
+        if let (Some(g), Some(name)) = (g, names.remove(&place)) {
+            gathered.insert(name, g);
+        }
+    }
     let mut chosen: [Option<String>; 5] = Default::default();
     for kind in Kind::ALL {
         chosen[kind.index()] =
@@ -352,15 +366,38 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
     let imu_noise = imu
         .imu_covariance
         .map(|(w, f)| noise_from_covariance(&w, &f, &options.c_vs, nominal_dt));
-    let gnss = take(Kind::Gnss)?;
-    let vel = take(Kind::GnssVel)?;
-    let baro = take(Kind::Baro)?;
-    let odometry = take(Kind::Odometry)?;
+    let gathered = [Kind::Gnss, Kind::GnssVel, Kind::Baro, Kind::Odometry].map(take);
+    let [gnss, vel, baro, odometry] = gathered;
     let topic = |k: Kind| chosen[k.index()].clone().unwrap_or_default();
+    let aids = aids(
+        path,
+        [topic(Kind::Gnss), topic(Kind::Baro)],
+        [gnss?, vel?, baro?, odometry?],
+        options,
+    )?;
+    Ok(BagPlan {
+        path: path.to_path_buf(),
+        topics,
+        chosen,
+        nominal_dt,
+        imu_noise,
+        aids,
+        options: options.clone(),
+    })
+}
+
+/// The aids of the chosen topics' messages (GNSS, velocity, barometer, odometry as
+/// gathered; `topics` the GNSS and barometer topics' names for errors), in the
+/// session's frames and units and in time order.
+fn aids(
+    path: &Path,
+    topics: [String; 2],
+    [gnss, vel, baro, odometry]: [Gathered; 4],
+    options: &BagReadOptions,
+) -> Result<BagAids, BagError> {
+    let [gnss_topic, baro_topic] = topics;
     let mut aids = BagAids::default();
-    let (fixes, no_fix) = fixes(path, &topic(Kind::Gnss), &gnss.fixes, options)?;
-    aids.fixes = fixes;
-    aids.no_fix = no_fix;
+    (aids.fixes, aids.no_fix) = fixes(path, &gnss_topic, &gnss.fixes, options)?;
     aids.unmatched_velocities = join_velocities(&mut aids.fixes, &vel.twists, options);
     aids.baro = baro
         .pressures
@@ -371,7 +408,7 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
                 .ok_or_else(|| {
                     BagError::topic(
                         path,
-                        &topic(Kind::Baro),
+                        &baro_topic,
                         *i,
                         Some("fluid_pressure"),
                         format!("{} Pa is not a pressure (must be > 0)", p.fluid_pressure),
@@ -386,15 +423,7 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
         .collect();
     sort_by_time(&mut aids.baro);
     sort_by_time(&mut aids.odometer);
-    Ok(BagPlan {
-        path: path.to_path_buf(),
-        topics,
-        chosen,
-        nominal_dt,
-        imu_noise,
-        aids,
-        options: options.clone(),
-    })
+    Ok(aids)
 }
 
 /// Sorts `(t, x)` readings by time (bags store messages in arrival order).
@@ -550,6 +579,7 @@ impl BagPlan {
             offset: self.options.time_offset,
             window: (self.options.t_start, self.options.t_end),
             nominal_dt: self.nominal_dt,
+            place: None,
             prev: None,
             started: false,
             finished: false,
@@ -567,6 +597,8 @@ pub struct BagImu {
     offset: f64,
     window: (Option<f64>, Option<f64>),
     nominal_dt: f64,
+    /// The IMU topic's place in the stream ([`Message::topic_index`]), once seen.
+    place: Option<usize>,
     prev: Option<(f64, u64)>,
     started: bool,
     finished: bool,
@@ -579,16 +611,20 @@ impl BagImu {
     }
 
     /// The next IMU message decoded: `(index, t, ω, f)`.
-    fn next_message(&mut self) -> Result<Option<(u64, f64, Imu)>, BagError> {
+    fn next_message(&mut self) -> Result<Option<(u64, f64, ImuMotion)>, BagError> {
         let (path, topic, offset) = (&self.path, &self.topic, self.offset);
+        let place = &mut self.place;
         loop {
             let got = self.stream.next_with(|m| {
-                if m.topic.name != *topic {
-                    return Ok(None);
+                // The topic's place, once known, spares a name comparison per message.
+                match *place {
+                    Some(p) if p != m.topic_index => return Ok(None),
+                    None if m.topic.name != *topic => return Ok(None),
+                    _ => *place = Some(m.topic_index),
                 }
-                let imu =
-                    Imu::decode(m.data).map_err(|e| BagError::decode(path, topic, m.index, e))?;
-                Ok(Some((m.index, imu.header.seconds() + offset, imu)))
+                let imu = ImuMotion::decode(m.data)
+                    .map_err(|e| BagError::decode(path, topic, m.index, e))?;
+                Ok(Some((m.index, imu.t + offset, imu)))
             })?;
             match got {
                 None => return Ok(None),
@@ -599,7 +635,7 @@ impl BagImu {
     }
 
     /// The sample of message `index` at `t`: increments over `(t_prev, t]`.
-    fn sample(&mut self, index: u64, t: f64, imu: &Imu) -> Result<ImuSample, BagError> {
+    fn sample(&mut self, index: u64, t: f64, imu: &ImuMotion) -> Result<ImuSample, BagError> {
         let dt = match self.prev {
             Some((t_prev, i_prev)) if t <= t_prev => {
                 return Err(BagError::topic(

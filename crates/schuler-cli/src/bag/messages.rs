@@ -35,21 +35,32 @@ pub struct Header {
     pub frame_id: String,
 }
 
+/// The stamp in seconds (`sec + nanosec·10⁻⁹`).
+fn stamp_seconds(sec: i32, nanosec: u32) -> f64 {
+    f64::from(sec) + f64::from(nanosec) * 1e-9
+}
+
+/// A header's stamp `(sec, nanosec)`, `nanosec` checked below 10⁹.
+fn read_stamp(r: &mut CdrReader) -> Result<(i32, u32), CdrError> {
+    let sec = r.i32("header.stamp.sec")?;
+    let nanosec = r.u32("header.stamp.nanosec")?;
+    if nanosec >= 1_000_000_000 {
+        return Err(CdrError {
+            field: "header.stamp.nanosec".into(),
+            reason: format!("{nanosec} is not below 10^9"),
+        });
+    }
+    Ok((sec, nanosec))
+}
+
 impl Header {
     /// The stamp in seconds (`sec + nanosec·10⁻⁹`).
     pub fn seconds(&self) -> f64 {
-        f64::from(self.sec) + f64::from(self.nanosec) * 1e-9
+        stamp_seconds(self.sec, self.nanosec)
     }
 
     fn read(r: &mut CdrReader) -> Result<Self, CdrError> {
-        let sec = r.i32("header.stamp.sec")?;
-        let nanosec = r.u32("header.stamp.nanosec")?;
-        if nanosec >= 1_000_000_000 {
-            return Err(CdrError {
-                field: "header.stamp.nanosec".into(),
-                reason: format!("{nanosec} is not below 10^9"),
-            });
-        }
+        let (sec, nanosec) = read_stamp(r)?;
         let frame_id = r.string("header.frame_id")?;
         Ok(Self {
             sec,
@@ -65,13 +76,19 @@ impl Header {
     }
 }
 
-/// Three finite `float64`s of a `geometry_msgs/Vector3` (or `Point`) named `field`.
+/// Three finite `float64`s of a `geometry_msgs/Vector3` (or `Point`) named `field`
+/// (an error names the axis; nothing is allocated otherwise).
 fn vector3(r: &mut CdrReader, field: &str) -> Result<[f64; 3], CdrError> {
-    Ok([
-        r.finite(&format!("{field}.x"))?,
-        r.finite(&format!("{field}.y"))?,
-        r.finite(&format!("{field}.z"))?,
-    ])
+    let v = [r.f64(field)?, r.f64(field)?, r.f64(field)?];
+    for (x, axis) in v.iter().zip(["x", "y", "z"]) {
+        if !x.is_finite() {
+            return Err(CdrError {
+                field: format!("{field}.{axis}"),
+                reason: format!("{x} is not a finite number"),
+            });
+        }
+    }
+    Ok(v)
 }
 
 /// `sensor_msgs/msg/Imu`, without the orientation (not used).
@@ -87,6 +104,39 @@ pub struct Imu {
     pub linear_acceleration: [f64; 3],
     /// Its covariance, row-major [m²/s⁴].
     pub linear_acceleration_covariance: [f64; 9],
+}
+
+/// What navigation reads of a `sensor_msgs/msg/Imu`: the stamp [s], angular rate
+/// [rad/s] and specific force [m/s²] (frame and covariances skipped, nothing
+/// allocated).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuMotion {
+    /// The header's stamp [s].
+    pub t: f64,
+    /// Angular rate, IMU axes.
+    pub angular_velocity: [f64; 3],
+    /// Specific force, IMU axes.
+    pub linear_acceleration: [f64; 3],
+}
+
+impl ImuMotion {
+    /// Decodes a payload's stamp, rate and specific force (the covariances are only
+    /// checked to be there).
+    pub fn decode(payload: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(payload)?;
+        let (sec, nanosec) = read_stamp(&mut r)?;
+        r.skip_string("header.frame_id")?;
+        r.skip_f64s(4 + 9, "orientation")?;
+        let angular_velocity = vector3(&mut r, "angular_velocity")?;
+        r.skip_f64s(9, "angular_velocity_covariance")?;
+        let linear_acceleration = vector3(&mut r, "linear_acceleration")?;
+        r.skip_f64s(9, "linear_acceleration_covariance")?;
+        Ok(Self {
+            t: stamp_seconds(sec, nanosec),
+            angular_velocity,
+            linear_acceleration,
+        })
+    }
 }
 
 impl Imu {
@@ -440,6 +490,10 @@ mod tests {
             linear_acceleration: [0.5, 0.0, 9.8],
             linear_acceleration_covariance: [1e-4; 9],
         };
+        let motion = ImuMotion::decode(&imu.encode()).expect("motion");
+        assert_eq!(motion.t, imu.header.seconds());
+        assert_eq!(motion.angular_velocity, imu.angular_velocity);
+        assert_eq!(motion.linear_acceleration, imu.linear_acceleration);
         assert_eq!(Imu::decode(&imu.encode()), Ok(imu));
         assert!((header().seconds() - 345_600.005).abs() < 1e-10);
     }
