@@ -412,3 +412,29 @@ fn a_rest_bag_stays_at_rest() {
     assert!((last[4] - 100.0).abs() < 0.01, "{last:?}");
     assert!(last[5].abs() < 1e-3 && last[6].abs() < 1e-3, "{last:?}");
 }
+
+/// A bag has one clock: `--imu-time-offset` moves every topic's stamps, so the run
+/// shifted by −345600 s (a clock from 0) is the same trajectory at shifted times (the
+/// stamps' differences, and so every dt, are the same doubles: both subtractions are
+/// exact near 345600 s by Sterbenz's lemma).
+#[test]
+fn the_time_offset_moves_every_topic() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bag = data().join("drive.mcap");
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    nav_bag(&bag, &a, &[]).success();
+    nav_bag(&bag, &b, &["--imu-time-offset", "-345600"]).success();
+    let shifted: String = common::read_rows(&a.join("nav.txt"))
+        .iter()
+        .map(|r| {
+            let mut line = format!("0 {:.6}", r[1] - 345_600.0);
+            for x in &r[2..] {
+                line.push_str(&format!(" {x}"));
+            }
+            line + "\n"
+        })
+        .collect();
+    std::fs::write(dir.path().join("shifted.txt"), shifted).expect("write");
+    let digits = max_digits_apart(&dir.path().join("shifted.txt"), &b.join("nav.txt"));
+    assert!(digits <= 1.0, "{digits} units of the last digit apart");
+}
