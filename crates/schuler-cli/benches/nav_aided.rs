@@ -6,17 +6,18 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use schuler::earth::{Geodetic, Wgs84};
+use schuler::earth::Wgs84;
 use schuler::filter::{Gate, GnssFix, ImuNoise, IntegrationConfig};
 use schuler::session::FilterConfig;
-use schuler::sim::analytic::{self, Maneuvering};
+use schuler::sim::analytic;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
 use schuler_cli::aided::{Aiding, OutputNames};
-use schuler_cli::formats::{ImuReadOptions, ImuReader};
+use schuler_cli::formats::ImuReader;
 use schuler_cli::navigate::{NavSettings, navigate};
-use schuler_cli::options::EarthChoice;
 use schuler_cli::output::write_imu_text;
 use std::path::PathBuf;
+
+mod common;
 
 const T0: f64 = 86_400.0;
 const SECONDS: usize = 3600;
@@ -25,7 +26,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("nav_aided_{rate_hz}"));
     std::fs::create_dir_all(&dir).expect("bench directory");
     let imu = dir.join("imu.txt");
-    let traj = Maneuvering::flight(Geodetic::from_degrees(30.5, 114.3, 500.0));
+    let traj = common::flight();
     let dt = 1.0 / rate_hz;
     let n = (SECONDS as f64 * rate_hz) as usize;
     if !imu.exists() {
@@ -43,7 +44,6 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
             }
         })
         .collect();
-    let init = analytic::state(&Wgs84, &traj, 0.0);
     let spec = ImuSpec {
         rate_hz,
         preset: Some(Preset::Tactical),
@@ -53,18 +53,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         vibration: Vec::new(),
     };
     let noise = ImuNoise::from_model(&spec.model().expect("preset"));
-    let settings = NavSettings {
-        imu,
-        read: ImuReadOptions::default(),
-        init_pos: init.pos,
-        init_vel: init.v_n,
-        init_att: init.euler(),
-        output_rate: Some(1.0),
-        out: dir.join("out"),
-        earth: EarthChoice::Wgs84,
-        week: 2200,
-        mechanization: Default::default(),
-    };
+    let settings = common::settings(imu, dir.join("out"));
     let aiding = Aiding {
         fixes,
         filter: FilterConfig::new(IntegrationConfig {

@@ -38,6 +38,7 @@ fn bench_nav(c: &mut Criterion) {
         earth: EarthChoice::Wgs84,
         week: 2200,
         mechanization: Default::default(),
+        out_bag: None,
     };
     let mut group = c.benchmark_group("nav_end_to_end");
     group.sample_size(10);

@@ -112,9 +112,10 @@ impl AlignOptions {
 
 /// Read the samples from `start` up to `start + seconds` (and one more, which the
 /// caller may use to continue). Samples are read lazily and reading stops there.
-pub fn read_stage<I>(samples: &mut I, seconds: f64) -> Result<Vec<ImuSample>>
+pub fn read_stage<I, E>(samples: &mut I, seconds: f64) -> Result<Vec<ImuSample>>
 where
-    I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
 {
     let mut out: Vec<ImuSample> = Vec::new();
     for s in samples.by_ref() {

@@ -7,7 +7,7 @@
 //! returned.
 
 use crate::aided::record::InnovationLog;
-use crate::formats::InputError;
+use crate::bag::output::ResultBag;
 use crate::output::{NavEpoch, NavWriter, push_fixed};
 use anyhow::{Context, Result};
 use schuler::earth::EarthModel;
@@ -122,6 +122,8 @@ pub struct Outputs {
     pub nav: NavWriter,
     /// The filter's files, when a filter runs.
     pub filter: Option<FilterFiles>,
+    /// The result bag (`--out-bag`).
+    pub bag: Option<ResultBag>,
     last_written: f64,
     /// The first epoch whose heading standard deviation fell below 1°: its time and
     /// heading [rad].
@@ -134,6 +136,7 @@ impl Outputs {
         Self {
             nav,
             filter,
+            bag: None,
             last_written: f64::NAN,
             heading_settled: None,
         }
@@ -146,6 +149,9 @@ impl Outputs {
             wander_azimuth: e.wander_azimuth,
         })?;
         self.last_written = e.state.t;
+        if let Some(bag) = self.bag.as_mut() {
+            bag.write_epoch(e)?;
+        }
         if let Some(f) = &e.filter
             && self.heading_settled.is_none()
             && f.nav_std[2].z < 1f64.to_radians()
@@ -254,15 +260,16 @@ pub struct Driven {
 /// there, its last state is written (if it was not an output epoch) and the error is
 /// returned in [`Driven::failure`] with the count and the time reached. `None` when
 /// the input held no sample at all.
-pub fn drive<E: EarthModel, I>(
-    mut session: Session<E>,
+pub fn drive<M: EarthModel, I, E>(
+    mut session: Session<M>,
     samples: I,
     mut out: Outputs,
     dir: &Path,
     mut on_sample: impl FnMut(u64),
 ) -> Result<Option<Driven>>
 where
-    I: Iterator<Item = Result<ImuSample, InputError>>,
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
 {
     let mut n = 0u64;
     let mut failure: Option<anyhow::Error> = None;
@@ -299,6 +306,9 @@ where
         Err(e) => {
             // What was written stays whole: the files are closed before the error.
             let epochs = out.nav.finish()?;
+            if let Some(bag) = out.bag {
+                bag.finish()?;
+            }
             if let Some(files) = out.filter {
                 files.finish(dir)?;
             }
@@ -310,6 +320,9 @@ where
         }
     };
     let epochs = out.nav.finish()?;
+    if let Some(bag) = out.bag {
+        bag.finish()?;
+    }
     let failure = failure.map(|e| {
         e.context(format!(
             "stopped after {} samples; {epochs} epochs up to t = {} were written to {}",

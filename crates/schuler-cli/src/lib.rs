@@ -3,6 +3,8 @@
 
 pub mod aided;
 pub mod alignment;
+pub mod bag;
+pub mod bag_input;
 pub mod commands;
 pub mod drive;
 pub mod fixed;

@@ -33,6 +33,8 @@ enum Command {
     Platform(schuler_cli::commands::platform::Args),
     /// Errors of a navigation result (KF-GINS text or CSV) against a truth file.
     Compare(schuler_cli::commands::compare::Args),
+    /// ROS 2 bags (MCAP): `bag info FILE` lists topics, types, counts, rates, spans.
+    Bag(schuler_cli::commands::bag::Args),
     /// Noise of a static IMU log: Allan deviations, IEEE 952 terms, nav's noise config.
     Allan(schuler_cli::commands::allan::Args),
 }
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
         Command::Platform(args) => schuler_cli::commands::platform::run(args),
         Command::Compare(args) => schuler_cli::commands::compare::run(args),
         Command::Allan(args) => schuler_cli::commands::allan::run(args),
+        Command::Bag(args) => schuler_cli::commands::bag::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,7 +6,7 @@
 use crate::aided::Aiding;
 use crate::aided::report::{ReportData, RunFacts};
 use crate::drive::{Driven, FilterFiles, Outputs, drive, write_smoothed};
-use crate::formats::{ImuReadOptions, InputError};
+use crate::formats::ImuReadOptions;
 use crate::options::EarthChoice;
 use crate::output::NavWriter;
 use anyhow::{Result, bail};
@@ -45,6 +45,8 @@ pub struct NavSettings {
     pub week: u32,
     /// The mechanization and its hand-over latitudes.
     pub mechanization: MechanizationConfig,
+    /// The result bag to write (`--out-bag`), if any.
+    pub out_bag: Option<PathBuf>,
 }
 
 impl NavSettings {
@@ -117,7 +119,11 @@ fn outputs<E: EarthModel>(
         Some(a) => Some(FilterFiles::create(out, a.names.std, a.names.imu_err)?),
         None => None,
     };
-    Ok(Outputs::new(writer, files))
+    let mut outputs = Outputs::new(writer, files);
+    if let Some(path) = &settings.out_bag {
+        outputs.bag = Some(crate::bag::output::ResultBag::create(path)?);
+    }
+    Ok(outputs)
 }
 
 /// The facts of an aided run, with summary `s`, that the report states.
@@ -176,7 +182,7 @@ fn finish_aided<E: EarthModel>(
 /// Navigate `samples` (the first carries `start`) on `earth` with the settings and,
 /// if given, the aiding; write everything into `settings.out`. On a read error all
 /// that was computed is written before the error is returned.
-pub fn navigate<E: EarthModel, I>(
+pub fn navigate<E: EarthModel, I, Fail>(
     earth: E,
     settings: &NavSettings,
     aiding: Option<&Aiding>,
@@ -185,7 +191,8 @@ pub fn navigate<E: EarthModel, I>(
     on_sample: impl FnMut(u64),
 ) -> Result<RunSummary>
 where
-    I: Iterator<Item = Result<ImuSample, InputError>>,
+    I: Iterator<Item = Result<ImuSample, Fail>>,
+    Fail: std::error::Error + Send + Sync + 'static,
 {
     let (session, outputs) = open(earth, settings, aiding, start)?;
     let driven = drive(session, samples, outputs, &settings.out, on_sample)?;
@@ -280,7 +287,7 @@ fn check_clocks(settings: &NavSettings, a: &Aiding, s: &Summary) -> Result<()> {
 /// seconds past the first sample; the most likely goes on. Returns the summary, the
 /// kept member's initial heading [rad], and the time the bank decided [s].
 #[allow(clippy::too_many_arguments)] // the run's inputs, as navigate's, plus the bank's two
-pub fn navigate_any_heading<E: EarthModel, I>(
+pub fn navigate_any_heading<E: EarthModel, I, Fail>(
     earth: E,
     settings: &NavSettings,
     aiding: &Aiding,
@@ -291,7 +298,8 @@ pub fn navigate_any_heading<E: EarthModel, I>(
     on_sample: impl FnMut(u64),
 ) -> Result<(RunSummary, f64, f64)>
 where
-    I: Iterator<Item = Result<ImuSample, InputError>>,
+    I: Iterator<Item = Result<ImuSample, Fail>>,
+    Fail: std::error::Error + Send + Sync + 'static,
 {
     let config = settings.session_config(Some(aiding));
     let mut bank = HeadingBank::new(earth, config, start, members)

@@ -105,6 +105,7 @@ fn run(dir: &Path, imu: PathBuf) -> Errors {
             choice: MechanizationChoice::Ned,
             ..MechanizationConfig::default()
         },
+        out_bag: None,
     };
     let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
     navigate(

@@ -118,6 +118,7 @@ fn run(mechanization: MechanizationConfig, out: &Path) -> Summary {
         earth: EarthChoice::Wgs84,
         week: 0,
         mechanization,
+        out_bag: None,
     };
     let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
     navigate(

@@ -297,6 +297,11 @@ pub struct AidingOptions {
     /// Elevation of the baseline above the IMU's front-right plane [deg] (default 0).
     #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
     pub dual_antenna_baseline_pitch: Option<f64>,
+    /// Aids read from a ROS 2 bag (`nav --bag`): used where no file of the same kind
+    /// is given.
+    #[arg(skip)]
+    #[serde(skip)]
+    pub bag: Option<crate::bag::input::BagAids>,
 }
 
 impl AidingOptions {
@@ -352,7 +357,8 @@ impl AidingOptions {
             vehicle_lever_arm,
             dual_antenna,
             dual_antenna_baseline_yaw,
-            dual_antenna_baseline_pitch
+            dual_antenna_baseline_pitch,
+            bag
         )
     }
 
@@ -381,12 +387,21 @@ impl AidingOptions {
     /// Whether any aiding source is given (GNSS, barometer or a vehicle aid).
     pub fn any(&self) -> bool {
         self.gnss.is_some()
+            || self
+                .bag
+                .as_ref()
+                .is_some_and(|b| !b.fixes.is_empty() || !b.baro.is_empty())
+            || self.has_odometer()
             || self.baro.is_some()
             || self.zupt.is_some()
             || self.zupt_detect
             || self.nhc
-            || self.odometer.is_some()
             || self.dual_antenna.is_some()
+    }
+
+    /// Whether odometer readings are given (`--odometer`, or a bag's odometry).
+    pub fn has_odometer(&self) -> bool {
+        self.odometer.is_some() || self.bag.as_ref().is_some_and(|b| !b.odometer.is_empty())
     }
 
     /// Load the aiding data and check every value; `None` without any aiding source
@@ -455,7 +470,11 @@ impl AidingOptions {
                 }
                 log.fixes
             }
-            None => Vec::new(),
+            None => self
+                .bag
+                .as_ref()
+                .map(|b| b.fixes.clone())
+                .unwrap_or_default(),
         };
         if let Some(v) = &self.gnss_vel {
             let unmatched = crate::formats::gnss::merge_velocity(&mut fixes, v, vel_std)?;
@@ -620,10 +639,11 @@ impl AidingOptions {
     /// The barometer's readings `(t, h)` and `(noise, bias prior)` standard
     /// deviations [m].
     fn baro(&self) -> Result<BaroInput> {
-        let Some(path) = &self.baro else {
-            return Ok((Vec::new(), None));
+        let readings = match (&self.baro, &self.bag) {
+            (Some(path), _) => crate::formats::gnss::read_baro(path)?,
+            (None, Some(bag)) if !bag.baro.is_empty() => bag.baro.clone(),
+            _ => return Ok((Vec::new(), None)),
         };
-        let readings = crate::formats::gnss::read_baro(path)?;
         let std = quantity("baro-std", &self.baro_std, Dimension::Length)?.unwrap_or(0.5);
         let bias =
             quantity("baro-bias-std", &self.baro_bias_std, Dimension::Length)?.unwrap_or(10.0);

@@ -74,19 +74,19 @@ pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
         (
             o.odometer_std.is_some(),
             "odometer-std",
-            o.odometer.is_some(),
+            o.has_odometer(),
             "--odometer",
         ),
         (
             o.odometer_scale_std.is_some(),
             "odometer-scale-std",
-            o.odometer.is_some(),
+            o.has_odometer(),
             "--odometer",
         ),
         (
             o.estimate_mounting.is_some(),
             "estimate-mounting",
-            o.nhc || o.odometer.is_some(),
+            o.nhc || o.has_odometer(),
             "--nhc or --odometer",
         ),
         (
@@ -174,10 +174,18 @@ fn odometer(
     o: &AidingOptions,
     readings: &mut Vec<(f64, f64)>,
 ) -> Result<(Option<f64>, Option<f64>)> {
-    let odometer_std = match &o.odometer {
-        None => None,
-        Some(path) => {
-            *readings = crate::formats::vehicle::read_odometer(path)?;
+    let from_bag = o
+        .bag
+        .as_ref()
+        .map(|b| &b.odometer)
+        .filter(|v| !v.is_empty());
+    let odometer_std = match (&o.odometer, from_bag) {
+        (None, None) => None,
+        (path, bag) => {
+            *readings = match (path, bag) {
+                (Some(path), _) => crate::formats::vehicle::read_odometer(path)?,
+                (None, bag) => bag.cloned().unwrap_or_default(),
+            };
             Some(positive(
                 "odometer-std",
                 &o.odometer_std,

@@ -208,6 +208,7 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
             choice: MechanizationChoice::Ned,
             ..MechanizationConfig::default()
         },
+        out_bag: None,
     };
     let aiding = Aiding {
         fixes,

@@ -3,6 +3,7 @@
 
 pub mod align;
 pub mod allan;
+pub mod bag;
 pub mod channel;
 pub mod compare;
 pub mod demo;

@@ -106,6 +106,9 @@ pub struct NavArgs {
     /// GNSS aiding (with --gnss): the error-state Kalman filter.
     #[command(flatten)]
     pub aiding: AidingOptions,
+    /// ROS 2 bags: `--bag` as the input, `--out-bag` for the result.
+    #[command(flatten)]
+    pub bag: crate::bag_input::BagArgs,
 }
 
 /// The same options as a TOML file.
@@ -204,6 +207,9 @@ pub struct NavPlan {
     pub alignment: AlignOptions,
     /// The aiding options.
     pub aiding: AidingOptions,
+    /// Whether the IMU's axes were given (`--imu-axes`, `--imu-rotation`): a bag's
+    /// IMU is FLU otherwise.
+    pub axes_given: bool,
 }
 
 /// The initial position of flags over config, checked.
@@ -259,12 +265,20 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
     if in_motion && align_on {
         bail!("--init gnss starts in motion; --align starts at rest: give one of them");
     }
+    let input = args.input.clone().or(cfg.input.clone());
+    let axes_given = input.imu_axes.is_some() || input.imu_rotation.is_some();
+    if args.bag.bag.is_some() {
+        check_bag_input(&input)?;
+    }
     let settings = NavSettings {
         imu: args
             .imu
             .clone()
             .or(cfg.imu.clone())
-            .context("no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config)")?,
+            .or(args.bag.bag.clone())
+            .context(
+                "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config) or --bag BAG",
+            )?,
         read: read_options(&args, &cfg)?,
         init_pos: if in_motion {
             Geodetic::new(0.0, 0.0, 0.0)
@@ -282,6 +296,7 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
         earth: args.earth.or(cfg.earth).unwrap_or_default(),
         week: args.week.or(cfg.week).unwrap_or(0),
         mechanization: mechanization_config(&args, &cfg)?,
+        out_bag: args.bag.out_bag.clone(),
     };
     let alignment = args
         .alignment
@@ -301,11 +316,34 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
         init,
         alignment,
         aiding,
+        axes_given,
     })
 }
 
+/// The IMU input options that say how a text log is laid out have no meaning for a
+/// bag (its messages say it): refused rather than ignored.
+fn check_bag_input(input: &ImuInputOptions) -> Result<()> {
+    for (given, flag) in [
+        (input.imu_format.is_some(), "--imu-format"),
+        (input.imu_layout.is_some(), "--imu-layout"),
+        (input.imu_columns.is_some(), "--imu-columns"),
+        (input.gyro_unit.is_some(), "--gyro-unit"),
+        (input.accel_unit.is_some(), "--accel-unit"),
+        (input.imu_time_unit.is_some(), "--imu-time-unit"),
+        (input.imu_rate.is_some(), "--imu-rate"),
+    ] {
+        if given {
+            bail!(
+                "{flag} does not apply to --bag: sensor_msgs/Imu holds rates in rad/s and \
+                 m/s^2 with header stamps"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A progress bar over the IMU file's bytes.
-fn progress_bar(imu: &Path) -> ProgressBar {
+pub(crate) fn progress_bar(imu: &Path) -> ProgressBar {
     let total = std::fs::metadata(imu).map(|m| m.len()).unwrap_or(0);
     let bar = ProgressBar::with_draw_target(Some(total), indicatif::ProgressDrawTarget::stderr());
     bar.set_style(
@@ -322,13 +360,17 @@ fn progress_bar(imu: &Path) -> ProgressBar {
 /// as the first estimates) and the samples after the alignment's end, the carrier of
 /// the start first. With aiding, the filter's prior becomes the alignment's
 /// ([`Prior::from_alignment`]).
-fn align_first(
+fn align_first<I, E>(
     settings: &NavSettings,
     opts: &AlignOptions,
-    reader: &mut ImuReader<std::io::BufReader<std::fs::File>>,
+    reader: &mut I,
     aiding: Option<&mut Aiding>,
     bar: &ProgressBar,
-) -> Result<(Start, Vec<ImuSample>)> {
+) -> Result<(Start, Vec<ImuSample>)>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
     let (cfg, noise) = opts.resolve()?;
     let samples = crate::alignment::read_stage(reader, cfg.coarse + cfg.fine)?;
     let a = crate::alignment::align_on(settings.earth, settings.init_pos, &samples, &noise, &cfg)
@@ -350,12 +392,16 @@ fn align_first(
 /// the course's first long straight chord, or without a heading the first fix two
 /// seconds into the log), printed; the filter's prior becomes its standard deviations.
 /// Returns the start and the samples from its carrier on.
-fn start_from_fixes(
+fn start_from_fixes<I, E>(
     settings: &NavSettings,
-    reader: &mut ImuReader<std::io::BufReader<std::fs::File>>,
+    reader: &mut I,
     aiding: Option<&mut Aiding>,
     init: InitChoice,
-) -> Result<(Start, Vec<ImuSample>)> {
+) -> Result<(Start, Vec<ImuSample>)>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
     use schuler::align::in_motion::{
         InMotionConfig, VELOCITY_SPAN, course_pair, start_at_fix, start_in_motion,
     };
@@ -433,9 +479,10 @@ struct Begin<'a> {
 impl Begin<'_> {
     /// Navigate on the settings' Earth model: from the start, or through the heading
     /// bank (printing its choice).
-    fn navigate<I>(&self, samples: I, on_sample: impl FnMut(u64)) -> Result<RunSummary>
+    fn navigate<I, E>(&self, samples: I, on_sample: impl FnMut(u64)) -> Result<RunSummary>
     where
-        I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+        I: Iterator<Item = Result<ImuSample, E>>,
+        E: std::error::Error + Send + Sync + 'static,
     {
         match self.settings.earth {
             EarthChoice::Wgs84 => self.navigate_on(Wgs84, samples, on_sample),
@@ -447,14 +494,15 @@ impl Begin<'_> {
     }
 
     /// [`Begin::navigate`] on `earth`.
-    fn navigate_on<E: schuler::earth::EarthModel, I>(
+    fn navigate_on<M: schuler::earth::EarthModel, I, E>(
         &self,
-        earth: E,
+        earth: M,
         samples: I,
         on_sample: impl FnMut(u64),
     ) -> Result<RunSummary>
     where
-        I: Iterator<Item = Result<ImuSample, crate::formats::InputError>>,
+        I: Iterator<Item = Result<ImuSample, E>>,
+        E: std::error::Error + Send + Sync + 'static,
     {
         let (settings, start) = (self.settings, self.start);
         match (self.aiding, self.any_heading) {
@@ -480,26 +528,78 @@ impl Begin<'_> {
     }
 }
 
-/// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
-/// [`crate::commands::run_nav`]).
-pub fn run(args: NavArgs) -> Result<()> {
-    let NavPlan {
-        settings,
-        align,
-        init,
-        alignment,
-        aiding: aiding_opts,
-    } = parse_nav_args(args)?;
-    // --imu-grade serves the alignment and the filter alike. Its default is
-    // navigation grade for alignment (gyrocompassing needs it) but tactical for the
-    // filter: an optimistic noise model makes the gate refuse good fixes, a
-    // pessimistic one only costs a little accuracy.
-    let grade = alignment.imu_grade.unwrap_or(if aiding_opts.any() {
+/// The filter's IMU grade: `--imu-grade`, else navigation grade for alignment
+/// (gyrocompassing needs it) but tactical for the filter: an optimistic noise model
+/// makes the gate refuse good fixes, a pessimistic one only costs a little accuracy.
+pub(crate) fn filter_grade(plan: &NavPlan) -> GradeChoice {
+    plan.alignment.imu_grade.unwrap_or(if plan.aiding.any() {
         GradeChoice::Tactical
     } else {
         GradeChoice::Navigation
-    });
-    let mut aiding: Option<Aiding> = aiding_opts.resolve(grade.noise()?)?;
+    })
+}
+
+/// The run from an open IMU source: the start (given, aligned at rest, or from the
+/// fixes in motion), then the samples navigated and written; `on_sample` as in
+/// [`navigate`].
+pub(crate) fn navigate_samples<I, E>(
+    plan: &NavPlan,
+    aiding: &mut Option<Aiding>,
+    reader: &mut I,
+    bar: &ProgressBar,
+    on_sample: impl FnMut(u64),
+) -> Result<RunSummary>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
+    let settings = &plan.settings;
+    let (start, head) = match (plan.align, plan.init) {
+        (true, _) => align_first(settings, &plan.alignment, reader, aiding.as_mut(), bar)?,
+        (false, InitChoice::Given) => (settings.start(), Vec::new()),
+        (false, init) => start_from_fixes(settings, reader, aiding.as_mut(), init)?,
+    };
+    let samples = head.into_iter().map(Ok).chain(reader);
+    let begin = Begin {
+        settings,
+        aiding: aiding.as_ref(),
+        start,
+        any_heading: plan.init == InitChoice::GnssAnyHeading,
+    };
+    begin.navigate(samples, on_sample)
+}
+
+/// The run's summary on stdout (aided or free-inertial), `secs` its wall time.
+pub(crate) fn print_summary(
+    plan: &NavPlan,
+    aiding: Option<&Aiding>,
+    summary: &RunSummary,
+    secs: f64,
+) -> Result<()> {
+    match aiding {
+        Some(a) => {
+            if plan.init != InitChoice::Given {
+                print_heading_settled(summary);
+            }
+            print_aided(&plan.settings, a, summary, secs)
+        }
+        None => {
+            print_free(&plan.settings, summary, secs);
+            Ok(())
+        }
+    }
+}
+
+/// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
+/// [`crate::commands::run_nav`]; `--bag` goes to [`crate::bag_input::run`]).
+pub fn run(args: NavArgs) -> Result<()> {
+    let bag = args.bag.clone();
+    let plan = parse_nav_args(args)?;
+    if bag.bag.is_some() {
+        return crate::bag_input::run(plan, &bag);
+    }
+    let mut aiding: Option<Aiding> = plan.aiding.resolve(filter_grade(&plan).noise()?)?;
+    let settings = &plan.settings;
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
@@ -513,40 +613,19 @@ pub fn run(args: NavArgs) -> Result<()> {
         1.0 / reader.nominal_dt()
     );
     let bar = progress_bar(&settings.imu);
-    let (start, head) = match (align, init) {
-        (true, _) => align_first(&settings, &alignment, &mut reader, aiding.as_mut(), &bar)?,
-        (false, InitChoice::Given) => (settings.start(), Vec::new()),
-        (false, _) => start_from_fixes(&settings, &mut reader, aiding.as_mut(), init)?,
-    };
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
-    let samples = head.into_iter().map(Ok).chain(&mut reader);
-    let begin = Begin {
-        settings: &settings,
-        aiding: aiding.as_ref(),
-        start,
-        any_heading: init == InitChoice::GnssAnyHeading,
-    };
-    let summary = begin.navigate(samples, on_sample)?;
+    let summary = navigate_samples(&plan, &mut aiding, &mut reader, &bar, on_sample)?;
     bar.set_position(reader.bytes_read());
     bar.finish_and_clear();
     let secs = started.elapsed().as_secs_f64();
-    match &aiding {
-        Some(a) => {
-            if init != InitChoice::Given {
-                print_heading_settled(&summary);
-            }
-            print_aided(&settings, a, &summary, secs)
-        }
-        None => {
-            let report = reader.gaps();
-            if !report.is_empty() {
-                eprintln!("warning: {}: {report}", settings.imu.display());
-            }
-            print_free(&settings, &summary, secs);
-            Ok(())
+    if aiding.is_none() {
+        let report = reader.gaps();
+        if !report.is_empty() {
+            eprintln!("warning: {}: {report}", settings.imu.display());
         }
     }
+    print_summary(&plan, aiding.as_ref(), &summary, secs)
 }
 
 /// The aided run's summary on stdout (and its outage test).

@@ -119,3 +119,5 @@ fn nav_drive_with(
         .arg(out)
         .assert()
 }
+
+pub mod bag;

@@ -1,0 +1,734 @@
+//! A bag as the session's input: the topics chosen by type (or by name when several
+//! have it), the aids read in a first pass (GNSS fixes with their velocities,
+//! barometer heights, odometer speeds), then the IMU samples streamed in a second.
+//!
+//! # Frames and units (REP 103, REP 105)
+//! - `sensor_msgs/Imu`: angular rate [rad/s] and specific force [m/s²] in the IMU's
+//!   axes, FLU by REP 103 unless told otherwise ([`BagReadOptions::c_vs`]); a sample
+//!   stamped `t` is taken as the mean rate over `(t_prev, t]`, so `dθ = ω·dt`,
+//!   `dv = f·dt` (the rectangular rule of the text readers), then turned to FRD.
+//!   The covariance diagonals, when given, are the white noise of one sample:
+//!   `ARW = σ_ω·√dt`, `VRW = σ_f·√dt` (a rate's white noise of density N averages over
+//!   dt to a standard deviation N/√dt).
+//! - `sensor_msgs/NavSatFix`: latitude, longitude [deg], height above the WGS 84
+//!   ellipsoid [m]; the covariance is ENU, so `σ_N² = C[4]`, `σ_E² = C[0]`,
+//!   `σ_D² = C[8]`. `NO_FIX` messages are skipped and counted.
+//! - `geometry_msgs/TwistWithCovarianceStamped`: the receiver's velocity in ENU,
+//!   `v_N = y, v_E = x, v_D = −z`, joined to the fix of the same stamp (within 1 µs).
+//! - `sensor_msgs/FluidPressure` [Pa]: the height of the ISA troposphere
+//!   ([`isa_height`]).
+//! - `nav_msgs/Odometry`: the forward speed `twist.twist.linear.x` of the child frame.
+//!
+//! Every time is the header stamp plus [`BagReadOptions::time_offset`] (one clock for
+//! every topic of a bag).
+
+use super::BagError;
+use super::container::{BagStream, Message, Topic};
+use super::info::{TopicSummary, scan};
+use super::messages::{
+    FLUID_PRESSURE, FluidPressure, IMU, Imu, ImuMotion, NAV_SAT_FIX, NavSatFix, ODOMETRY, Odometry,
+    STATUS_NO_FIX, TWIST, TwistStamped,
+};
+use nalgebra::{Matrix3, Vector3};
+use schuler::earth::Geodetic;
+use schuler::filter::GnssFix;
+use schuler::imu::ImuSample;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The kinds of topic a run reads, with their message type and the flag that
+/// chooses among several.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// IMU.
+    Imu,
+    /// GNSS position.
+    Gnss,
+    /// GNSS velocity.
+    GnssVel,
+    /// Barometer.
+    Baro,
+    /// Wheel odometry.
+    Odometry,
+}
+
+impl Kind {
+    /// Every kind.
+    pub const ALL: [Kind; 5] = [
+        Kind::Imu,
+        Kind::Gnss,
+        Kind::GnssVel,
+        Kind::Baro,
+        Kind::Odometry,
+    ];
+
+    /// The message type of its topics.
+    pub fn type_name(self) -> &'static str {
+        match self {
+            Kind::Imu => IMU,
+            Kind::Gnss => NAV_SAT_FIX,
+            Kind::GnssVel => TWIST,
+            Kind::Baro => FLUID_PRESSURE,
+            Kind::Odometry => ODOMETRY,
+        }
+    }
+
+    /// The flag that names its topic.
+    pub fn flag(self) -> &'static str {
+        match self {
+            Kind::Imu => "--imu-topic",
+            Kind::Gnss => "--gnss-topic",
+            Kind::GnssVel => "--gnss-vel-topic",
+            Kind::Baro => "--baro-topic",
+            Kind::Odometry => "--odom-topic",
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// How a bag is read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BagReadOptions {
+    /// The topic of each [`Kind`] (by [`Kind::index`]) when named; `"none"` reads none.
+    pub topics: [Option<String>; 5],
+    /// From the IMU message's axes to the vehicle's FRD (FLU by default:
+    /// `diag(1, −1, −1)`).
+    pub c_vs: Matrix3<f64>,
+    /// Seconds added to every stamp.
+    pub time_offset: f64,
+    /// First and last IMU time read [s, after the offset].
+    pub t_start: Option<f64>,
+    /// Last IMU time read.
+    pub t_end: Option<f64>,
+    /// Position standard deviations N, E, D [m] for fixes without a covariance.
+    pub default_gnss_std: Option<Vector3<f64>>,
+    /// Velocity standard deviation [m/s] for velocities without a covariance.
+    pub default_vel_std: f64,
+}
+
+impl Default for BagReadOptions {
+    fn default() -> Self {
+        Self {
+            topics: Default::default(),
+            c_vs: flu_to_frd(),
+            time_offset: 0.0,
+            t_start: None,
+            t_end: None,
+            default_gnss_std: None,
+            default_vel_std: 0.1,
+        }
+    }
+}
+
+/// FLU (REP 103) to FRD: `diag(1, −1, −1)`.
+pub fn flu_to_frd() -> Matrix3<f64> {
+    Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0))
+}
+
+/// The aids a bag holds, in the session's frames and units.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BagAids {
+    /// GNSS fixes in time order, with velocities where a twist had the same stamp.
+    pub fixes: Vec<GnssFix>,
+    /// `NO_FIX` messages skipped.
+    pub no_fix: u64,
+    /// Velocity messages without a fix at their stamp (not used).
+    pub unmatched_velocities: u64,
+    /// Barometer heights `(t, h)` [s, m].
+    pub baro: Vec<(f64, f64)>,
+    /// Odometer speeds `(t, v)` [s, m/s].
+    pub odometer: Vec<(f64, f64)>,
+}
+
+/// Intervals of the IMU's first messages kept to settle its nominal interval (as the
+/// text readers' lookahead).
+const LOOKAHEAD: usize = 200;
+
+/// What the first pass found on one topic of a kind we read.
+#[derive(Debug, Default)]
+struct Gathered {
+    imu_stamps: Vec<f64>,
+    imu_covariance: Option<([f64; 9], [f64; 9])>,
+    fixes: Vec<(u64, NavSatFix)>,
+    twists: Vec<(u64, TwistStamped)>,
+    pressures: Vec<(u64, FluidPressure)>,
+    odometry: Vec<(u64, Odometry)>,
+    /// The first decoding error (reported only if the topic is chosen).
+    error: Option<BagError>,
+}
+
+/// A bag read for a run: the chosen topics, the IMU's nominal interval and noise,
+/// the aids.
+#[derive(Debug, Clone)]
+pub struct BagPlan {
+    /// The bag.
+    pub path: PathBuf,
+    /// Every topic of the bag.
+    pub topics: Vec<TopicSummary>,
+    /// The chosen topic of each kind (by [`Kind`] order).
+    pub chosen: [Option<String>; 5],
+    /// Median interval of the IMU's first stamps [s].
+    pub nominal_dt: f64,
+    /// ARW [rad/√s] and VRW [m/s/√s] per FRD axis from the IMU's covariances, if given.
+    pub imu_noise: Option<(Vector3<f64>, Vector3<f64>)>,
+    /// The aids.
+    pub aids: BagAids,
+    options: BagReadOptions,
+}
+
+/// Whether `topic` is decodable as ROS 2 CDR: schema `ros2msg`/`ros2idl`, messages
+/// `cdr`.
+fn check_encoding(path: &Path, topic: &Topic) -> Result<(), BagError> {
+    if topic.message_encoding != "cdr" {
+        return Err(BagError::topic(
+            path,
+            &topic.name,
+            0,
+            None,
+            format!(
+                "message encoding {:?}: only ROS 2 CDR (\"cdr\") is read",
+                topic.message_encoding
+            ),
+        ));
+    }
+    if !matches!(topic.schema_encoding.as_str(), "ros2msg" | "ros2idl") {
+        return Err(BagError::topic(
+            path,
+            &topic.name,
+            0,
+            None,
+            format!(
+                "schema encoding {:?}: only ROS 2 message definitions (\"ros2msg\", \"ros2idl\") are read",
+                topic.schema_encoding
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Stores message `m` of a kind we read in `g` (decoding errors kept, not raised).
+fn gather(path: &Path, m: &Message, g: &mut Gathered) {
+    if g.error.is_some() || check_encoding(path, m.topic).is_err() {
+        return;
+    }
+    let err = |e| BagError::decode(path, &m.topic.name, m.index, e);
+    let result = match m.topic.type_name.as_str() {
+        IMU if g.imu_stamps.len() <= LOOKAHEAD => Imu::decode(m.data).map(|imu| {
+            if g.imu_covariance.is_none() && imu.angular_velocity_covariance[0] > 0.0 {
+                g.imu_covariance = Some((
+                    imu.angular_velocity_covariance,
+                    imu.linear_acceleration_covariance,
+                ));
+            }
+            g.imu_stamps.push(imu.header.seconds());
+        }),
+        NAV_SAT_FIX => NavSatFix::decode(m.data).map(|x| g.fixes.push((m.index, x))),
+        TWIST => TwistStamped::decode(m.data).map(|x| g.twists.push((m.index, x))),
+        FLUID_PRESSURE => FluidPressure::decode(m.data).map(|x| g.pressures.push((m.index, x))),
+        ODOMETRY => Odometry::decode(m.data).map(|x| g.odometry.push((m.index, x))),
+        _ => Ok(()),
+    };
+    if let Err(e) = result {
+        g.error = Some(err(e));
+    }
+}
+
+/// The topic of `kind`: the one named (`"none"`: no topic), else the only one of its
+/// type; several of the type without a name is an error listing them.
+fn choose(
+    path: &Path,
+    topics: &[TopicSummary],
+    kind: Kind,
+    named: Option<&str>,
+) -> Result<Option<String>, BagError> {
+    let of_type: Vec<&str> = topics
+        .iter()
+        .filter(|t| t.topic.type_name == kind.type_name())
+        .map(|t| t.topic.name.as_str())
+        .collect();
+    match named {
+        Some("none") => Ok(None),
+        Some(name) => {
+            let Some(t) = topics.iter().find(|t| t.topic.name == name) else {
+                return Err(BagError::file(
+                    path,
+                    format!(
+                        "{} {name}: no such topic; the bag's {} topics: {}",
+                        kind.flag(),
+                        kind.type_name(),
+                        list(&of_type)
+                    ),
+                ));
+            };
+            if t.topic.type_name != kind.type_name() {
+                return Err(BagError::topic(
+                    path,
+                    name,
+                    0,
+                    None,
+                    format!(
+                        "message schema {:?} is not {} ({} names a topic of that type; the bag's: {})",
+                        t.topic.type_name,
+                        kind.type_name(),
+                        kind.flag(),
+                        list(&of_type)
+                    ),
+                ));
+            }
+            check_encoding(path, &t.topic)?;
+            Ok(Some(name.to_owned()))
+        }
+        None => match of_type[..] {
+            [] => Ok(None),
+            [one] => {
+                let t = topics.iter().find(|t| t.topic.name == one);
+                if let Some(t) = t {
+                    check_encoding(path, &t.topic)?;
+                }
+                Ok(Some(one.to_owned()))
+            }
+            _ => Err(BagError::file(
+                path,
+                format!(
+                    "{} topics of type {}: choose one with {}",
+                    list(&of_type),
+                    kind.type_name(),
+                    kind.flag()
+                ),
+            )),
+        },
+    }
+}
+
+/// Names for a message: `a, b` or `(none)`.
+fn list(names: &[&str]) -> String {
+    if names.is_empty() {
+        "(none)".to_owned()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// The first pass over the bag at `path`: topics, the chosen ones, the IMU's
+/// interval and noise, the aids.
+pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> {
+    let mut by_place: Vec<Option<Gathered>> = Vec::new();
+    let known = Kind::ALL.map(Kind::type_name);
+    let mut names: HashMap<usize, String> = HashMap::new();
+    let topics = scan(path, |m| {
+        if known.contains(&m.topic.type_name.as_str()) {
+            if by_place.len() <= m.topic_index {
+                by_place.resize_with(m.topic_index + 1, || None);
+            }
+            let g = by_place[m.topic_index].get_or_insert_with(|| {
+                names.insert(m.topic_index, m.topic.name.clone());
+                Gathered::default()
+            });
+            gather(path, m, g);
+        }
+        Ok(())
+    })?;
+    let mut gathered: HashMap<String, Gathered> = HashMap::new();
+    for (place, g) in by_place.into_iter().enumerate() {
+        if let (Some(g), Some(name)) = (g, names.remove(&place)) {
+            gathered.insert(name, g);
+        }
+    }
+    let mut chosen: [Option<String>; 5] = Default::default();
+    for kind in Kind::ALL {
+        chosen[kind.index()] =
+            choose(path, &topics, kind, options.topics[kind.index()].as_deref())?;
+    }
+    let Some(imu_topic) = chosen[Kind::Imu.index()].clone() else {
+        return Err(BagError::file(
+            path,
+            format!("no {IMU} topic in the bag (topics: {})", {
+                let names: Vec<&str> = topics.iter().map(|t| t.topic.name.as_str()).collect();
+                list(&names)
+            }),
+        ));
+    };
+    let mut take = |kind: Kind| -> Result<Gathered, BagError> {
+        let g = chosen[kind.index()]
+            .as_ref()
+            .and_then(|t| gathered.remove(t))
+            .unwrap_or_default();
+        match g.error {
+            Some(e) => Err(e),
+            None => Ok(g),
+        }
+    };
+    let imu = take(Kind::Imu)?;
+    let nominal_dt = nominal_interval(path, &imu_topic, &imu.imu_stamps)?;
+    let imu_noise = imu
+        .imu_covariance
+        .map(|(w, f)| noise_from_covariance(&w, &f, &options.c_vs, nominal_dt));
+    let gathered = [Kind::Gnss, Kind::GnssVel, Kind::Baro, Kind::Odometry].map(take);
+    let [gnss, vel, baro, odometry] = gathered;
+    let topic = |k: Kind| chosen[k.index()].clone().unwrap_or_default();
+    let aids = aids(
+        path,
+        [topic(Kind::Gnss), topic(Kind::Baro)],
+        [gnss?, vel?, baro?, odometry?],
+        options,
+    )?;
+    Ok(BagPlan {
+        path: path.to_path_buf(),
+        topics,
+        chosen,
+        nominal_dt,
+        imu_noise,
+        aids,
+        options: options.clone(),
+    })
+}
+
+/// The aids of the chosen topics' messages (GNSS, velocity, barometer, odometry as
+/// gathered; `topics` the GNSS and barometer topics' names for errors), in the
+/// session's frames and units and in time order.
+fn aids(
+    path: &Path,
+    topics: [String; 2],
+    [gnss, vel, baro, odometry]: [Gathered; 4],
+    options: &BagReadOptions,
+) -> Result<BagAids, BagError> {
+    let [gnss_topic, baro_topic] = topics;
+    let mut aids = BagAids::default();
+    (aids.fixes, aids.no_fix) = fixes(path, &gnss_topic, &gnss.fixes, options)?;
+    aids.unmatched_velocities = join_velocities(&mut aids.fixes, &vel.twists, options);
+    aids.baro = baro
+        .pressures
+        .iter()
+        .map(|(i, p)| {
+            isa_height(p.fluid_pressure)
+                .map(|h| (p.header.seconds() + options.time_offset, h))
+                .ok_or_else(|| {
+                    BagError::topic(
+                        path,
+                        &baro_topic,
+                        *i,
+                        Some("fluid_pressure"),
+                        format!("{} Pa is not a pressure (must be > 0)", p.fluid_pressure),
+                    )
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    aids.odometer = odometry
+        .odometry
+        .iter()
+        .map(|(_, o)| (o.header.seconds() + options.time_offset, o.linear[0]))
+        .collect();
+    sort_by_time(&mut aids.baro);
+    sort_by_time(&mut aids.odometer);
+    Ok(aids)
+}
+
+/// Sorts `(t, x)` readings by time (bags store messages in arrival order).
+fn sort_by_time(v: &mut [(f64, f64)]) {
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+}
+
+/// Median of the intervals between the IMU's first stamps.
+fn nominal_interval(path: &Path, topic: &str, stamps: &[f64]) -> Result<f64, BagError> {
+    let mut dts: Vec<f64> = stamps.windows(2).map(|w| w[1] - w[0]).collect();
+    dts.sort_by(f64::total_cmp);
+    match dts.get(dts.len() / 2) {
+        Some(&dt) if dt > 0.0 => Ok(dt),
+        _ => Err(BagError::topic(
+            path,
+            topic,
+            0,
+            Some("header.stamp"),
+            "fewer than two increasing stamps: cannot settle the sample interval",
+        )),
+    }
+}
+
+/// ARW and VRW per FRD axis from one sample's rate covariances (IMU axes), turned by
+/// `c_vs`: `N = √(diag(C Σ Cᵀ)·dt)`.
+fn noise_from_covariance(
+    w: &[f64; 9],
+    f: &[f64; 9],
+    c_vs: &Matrix3<f64>,
+    dt: f64,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let density = |cov: &[f64; 9]| {
+        let s = Matrix3::from_row_slice(cov);
+        (c_vs * s * c_vs.transpose())
+            .diagonal()
+            .map(|v| (v.max(0.0) * dt).sqrt())
+    };
+    (density(w), density(f))
+}
+
+/// The fixes of `msgs` (topic `topic`) in time order, and the count of `NO_FIX`.
+fn fixes(
+    path: &Path,
+    topic: &str,
+    msgs: &[(u64, NavSatFix)],
+    options: &BagReadOptions,
+) -> Result<(Vec<GnssFix>, u64), BagError> {
+    let mut out = Vec::with_capacity(msgs.len());
+    let mut no_fix = 0;
+    for (i, m) in msgs {
+        if m.status == STATUS_NO_FIX {
+            no_fix += 1;
+            continue;
+        }
+        let bad =
+            |field: &str, reason: String| BagError::topic(path, topic, *i, Some(field), reason);
+        for (field, x, limit) in [
+            ("latitude", m.latitude, 90.0),
+            ("longitude", m.longitude, 360.0),
+            ("altitude", m.altitude, f64::INFINITY),
+        ] {
+            if !(x.is_finite() && x.abs() <= limit) {
+                return Err(bad(
+                    field,
+                    format!("{x} is not a {field} (status {})", m.status),
+                ));
+            }
+        }
+        let c = &m.position_covariance;
+        let std = Vector3::new(c[4], c[0], c[8]).map(f64::sqrt);
+        let pos_std = if m.position_covariance_type > 0 && std.iter().all(|s| *s > 0.0) {
+            std
+        } else {
+            options.default_gnss_std.ok_or_else(|| {
+                bad(
+                    "position_covariance",
+                    format!(
+                        "no usable covariance (type {}, diagonal {} {} {}): give --gnss-std N,E,D",
+                        m.position_covariance_type, c[0], c[4], c[8]
+                    ),
+                )
+            })?
+        };
+        out.push(GnssFix {
+            t: m.header.seconds() + options.time_offset,
+            pos: Geodetic::from_degrees(m.latitude, m.longitude, m.altitude),
+            pos_std,
+            vel: None,
+        });
+    }
+    out.sort_by(|a, b| a.t.total_cmp(&b.t));
+    Ok((out, no_fix))
+}
+
+/// Joins each ENU twist to the fix of the same stamp (within 1 µs) as an NED
+/// velocity; returns the twists without a fix.
+fn join_velocities(
+    fixes: &mut [GnssFix],
+    twists: &[(u64, TwistStamped)],
+    o: &BagReadOptions,
+) -> u64 {
+    let mut unmatched = 0;
+    for (_, tw) in twists {
+        let t = tw.header.seconds() + o.time_offset;
+        let j = fixes.partition_point(|f| f.t < t - 1e-6);
+        let Some(fix) = fixes.get_mut(j).filter(|f| (f.t - t).abs() <= 1e-6) else {
+            unmatched += 1;
+            continue;
+        };
+        let [e, n, u] = tw.linear;
+        let c = &tw.covariance;
+        let std = Vector3::new(c[7], c[0], c[14]).map(f64::sqrt);
+        let std = if std.iter().all(|s| *s > 0.0) {
+            std
+        } else {
+            Vector3::repeat(o.default_vel_std)
+        };
+        fix.vel = Some((Vector3::new(n, e, -u), std));
+    }
+    unmatched
+}
+
+/// ISA sea-level pressure p₀ [Pa].
+pub const ISA_P0: f64 = 101_325.0;
+/// ISA sea-level temperature T₀ [K].
+pub const ISA_T0: f64 = 288.15;
+/// ISA troposphere lapse rate L [K/m].
+pub const ISA_LAPSE: f64 = 0.0065;
+/// The troposphere's exponent `R*·L/(g₀·M)` with the U.S. Standard Atmosphere
+/// 1976's constants (R* = 8.314 32 J/(mol·K), g₀ = 9.806 65 m/s²,
+/// M = 0.028 964 4 kg/mol), whose tables the test checks.
+pub const ISA_EXPONENT: f64 = 8.314_32 * ISA_LAPSE / (9.806_65 * 0.028_964_4);
+
+/// Height [m] of pressure `p` [Pa] in the ISA troposphere (ICAO Doc 7488):
+/// `h = (T₀/L)·(1 − (p/p₀)^(R·L/(g₀·M)))`; `None` for `p ≤ 0`.
+pub fn isa_height(p: f64) -> Option<f64> {
+    (p > 0.0).then(|| ISA_T0 / ISA_LAPSE * (1.0 - (p / ISA_P0).powf(ISA_EXPONENT)))
+}
+
+impl BagPlan {
+    /// The chosen topic of `kind`.
+    pub fn topic(&self, kind: Kind) -> Option<&str> {
+        self.chosen[kind.index()].as_deref()
+    }
+
+    /// The second pass: the IMU samples, streamed.
+    pub fn imu_samples(&self) -> Result<BagImu, BagError> {
+        Ok(BagImu {
+            stream: BagStream::open(&self.path)?,
+            path: self.path.clone(),
+            topic: self.topic(Kind::Imu).unwrap_or_default().to_owned(),
+            c_vs: self.options.c_vs,
+            offset: self.options.time_offset,
+            window: (self.options.t_start, self.options.t_end),
+            nominal_dt: self.nominal_dt,
+            place: None,
+            prev: None,
+            started: false,
+            finished: false,
+        })
+    }
+}
+
+/// The IMU topic's samples in FRD increments, in file order (an error if the stamps
+/// do not increase).
+pub struct BagImu {
+    stream: BagStream,
+    path: PathBuf,
+    topic: String,
+    c_vs: Matrix3<f64>,
+    offset: f64,
+    window: (Option<f64>, Option<f64>),
+    nominal_dt: f64,
+    /// The IMU topic's place in the stream ([`Message::topic_index`]), once seen.
+    place: Option<usize>,
+    prev: Option<(f64, u64)>,
+    started: bool,
+    finished: bool,
+}
+
+impl BagImu {
+    /// Bytes of the bag read so far.
+    pub fn bytes_read(&self) -> u64 {
+        self.stream.bytes_read()
+    }
+
+    /// The next IMU message decoded: `(index, t, ω, f)`.
+    fn next_message(&mut self) -> Result<Option<(u64, f64, ImuMotion)>, BagError> {
+        let (path, topic, offset) = (&self.path, &self.topic, self.offset);
+        let place = &mut self.place;
+        loop {
+            let got = self.stream.next_with(|m| {
+                // The topic's place, once known, spares a name comparison per message.
+                match *place {
+                    Some(p) if p != m.topic_index => return Ok(None),
+                    None if m.topic.name != *topic => return Ok(None),
+                    _ => *place = Some(m.topic_index),
+                }
+                let imu = ImuMotion::decode(m.data)
+                    .map_err(|e| BagError::decode(path, topic, m.index, e))?;
+                Ok(Some((m.index, imu.t + offset, imu)))
+            })?;
+            match got {
+                None => return Ok(None),
+                Some(None) => continue,
+                Some(Some(x)) => return Ok(Some(x)),
+            }
+        }
+    }
+
+    /// The sample of message `index` at `t`: increments over `(t_prev, t]`.
+    fn sample(&mut self, index: u64, t: f64, imu: &ImuMotion) -> Result<ImuSample, BagError> {
+        let dt = match self.prev {
+            Some((t_prev, i_prev)) if t <= t_prev => {
+                return Err(BagError::topic(
+                    &self.path,
+                    &self.topic,
+                    index,
+                    Some("header.stamp"),
+                    format!("stamp {t} s does not follow message {i_prev}'s {t_prev} s"),
+                ));
+            }
+            Some((t_prev, _)) => t - t_prev,
+            None => self.nominal_dt,
+        };
+        self.prev = Some((t, index));
+        let w = Vector3::from(imu.angular_velocity);
+        let f = Vector3::from(imu.linear_acceleration);
+        Ok(ImuSample {
+            t,
+            dt,
+            dtheta: self.c_vs * (w * dt),
+            dvel: self.c_vs * (f * dt),
+        })
+    }
+}
+
+impl Iterator for BagImu {
+    type Item = Result<ImuSample, BagError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if self.finished {
+                return None;
+            }
+            let (index, t, imu) = match self.next_message() {
+                Ok(Some(x)) => x,
+                Ok(None) => {
+                    self.finished = true;
+                    return None;
+                }
+                Err(e) => {
+                    self.finished = true;
+                    return Some(Err(e));
+                }
+            };
+            let sample = self.sample(index, t, &imu);
+            if sample.is_err() {
+                self.finished = true;
+                return Some(sample);
+            }
+            if !self.started && self.window.0.is_some_and(|s| t < s) {
+                continue;
+            }
+            self.started = true;
+            if self.window.1.is_some_and(|e| t > e) {
+                self.finished = true;
+                return None;
+            }
+            return Some(sample);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ISA's table values (ICAO Doc 7488, U.S. Standard Atmosphere 1976): 1000 m
+    /// at 89 874.6 Pa, 5000 m at 54 019.9 Pa, 11 000 m at 22 632.1 Pa (geopotential
+    /// heights); the tables print 6 digits, so 0.5 of the last digit in pressure, about
+    /// 0.05 m in height near the ground and 0.3 m at 11 km.
+    #[test]
+    fn isa_heights_match_the_standard_tables() {
+        for (p, h, tol) in [
+            (101_325.0, 0.0, 1e-9),
+            (89_874.6, 1000.0, 0.05),
+            (54_019.9, 5000.0, 0.1),
+            (22_632.1, 11_000.0, 0.3),
+        ] {
+            let got = isa_height(p).expect("positive");
+            assert!((got - h).abs() < tol, "{p} Pa: {got} m, table {h} m");
+        }
+        assert_eq!(isa_height(0.0), None);
+    }
+
+    /// White noise of density N sampled every dt has σ = N/√dt: the covariance gives N
+    /// back, the FLU axes' y and z turned onto FRD's (same variances).
+    #[test]
+    fn covariance_gives_the_noise_density() {
+        let n = 0.003f64.to_radians() / 60.0; // 0.003 deg/√h in rad/√s
+        let dt: f64 = 0.005;
+        let var = (n / dt.sqrt()).powi(2);
+        let w = [var, 0.0, 0.0, 0.0, 4.0 * var, 0.0, 0.0, 0.0, 9.0 * var];
+        let (arw, _) = noise_from_covariance(&w, &w, &flu_to_frd(), dt);
+        assert!((arw - Vector3::new(n, 2.0 * n, 3.0 * n)).norm() < 1e-12 * n);
+    }
+}

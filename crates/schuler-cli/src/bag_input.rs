@@ -1,0 +1,140 @@
+//! `schuler nav --bag`: a ROS 2 bag as the run's input (its IMU, GNSS, velocity,
+//! barometer and odometry topics, [`crate::bag::input`]) and `--out-bag`, the result as
+//! a bag ([`crate::bag::output`]). The IMU's axes are FLU (REP 103) unless
+//! `--imu-axes`/`--imu-rotation` say otherwise; `--imu-time-offset` shifts every
+//! topic's stamps (a bag has one clock); `--gnss-std` and `--gnss-vel-std` stand in
+//! for missing covariances; the IMU's covariances give the noise model where
+//! `--arw`/`--vrw` are not given.
+
+use crate::bag::input::{BagPlan, BagReadOptions, Kind, flu_to_frd, plan};
+use crate::commands::nav::{NavPlan, filter_grade, navigate_samples, print_summary};
+use crate::options::Triple;
+use anyhow::{Result, bail};
+use indicatif::ProgressBar;
+use nalgebra::Vector3;
+use schuler::units::{Dimension, parse_as_or_si};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// The bag flags of `schuler nav`.
+#[derive(clap::Args, Debug, Default, Clone)]
+pub struct BagArgs {
+    /// A ROS 2 bag (.mcap file or rosbag2 directory) as the input: sensor_msgs/Imu,
+    /// NavSatFix, FluidPressure, geometry_msgs/TwistWithCovarianceStamped (GNSS
+    /// velocity, ENU) and nav_msgs/Odometry topics, found by type.
+    #[arg(long, value_name = "BAG", conflicts_with = "imu")]
+    pub bag: Option<PathBuf>,
+    /// The IMU topic, when the bag has several.
+    #[arg(long, value_name = "TOPIC")]
+    pub imu_topic: Option<String>,
+    /// The NavSatFix topic, when the bag has several (`none`: no GNSS).
+    #[arg(long, value_name = "TOPIC")]
+    pub gnss_topic: Option<String>,
+    /// The GNSS velocity topic (TwistWithCovarianceStamped, ENU), when several.
+    #[arg(long, value_name = "TOPIC")]
+    pub gnss_vel_topic: Option<String>,
+    /// The FluidPressure topic, when several.
+    #[arg(long, value_name = "TOPIC")]
+    pub baro_topic: Option<String>,
+    /// The Odometry topic (forward speed), when several.
+    #[arg(long, value_name = "TOPIC")]
+    pub odom_topic: Option<String>,
+    /// Also write the result as a ROS 2 bag (MCAP): nav_msgs/Odometry (pose in ENU),
+    /// sensor_msgs/NavSatFix and the sensor-error estimates (any IMU input).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub out_bag: Option<PathBuf>,
+}
+
+/// The reading options of the run's flags.
+fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<BagReadOptions> {
+    let read = &plan.settings.read;
+    let a = &plan.aiding;
+    let default_gnss_std = match a.gnss_std {
+        Some(Triple(s)) if s.iter().all(|&x| x > 0.0) => Some(Vector3::from(s)),
+        Some(Triple(s)) => bail!("--gnss-std must be positive, got {s:?}"),
+        None => None,
+    };
+    let default_vel_std = match &a.gnss_vel_std {
+        Some(text) => parse_as_or_si(text.trim(), Dimension::Velocity)?,
+        None => 0.1,
+    };
+    Ok(BagReadOptions {
+        topics: [
+            args.imu_topic.clone(),
+            args.gnss_topic.clone(),
+            args.gnss_vel_topic.clone(),
+            args.baro_topic.clone(),
+            args.odom_topic.clone(),
+        ],
+        c_vs: match (axes_given, read.c_vs) {
+            (false, _) => flu_to_frd(),
+            (true, c) => c.unwrap_or_else(nalgebra::Matrix3::identity),
+        },
+        time_offset: read.time_offset,
+        t_start: read.t_start,
+        t_end: read.t_end,
+        default_gnss_std,
+        default_vel_std,
+    })
+}
+
+/// The chosen topics and what was found, on stderr.
+fn describe(p: &BagPlan) {
+    for kind in Kind::ALL {
+        if let Some(t) = p.topic(kind) {
+            eprintln!("{}: {} from {t}", p.path.display(), kind.type_name());
+        }
+    }
+    eprintln!(
+        "{}: nominal IMU rate {:.6} Hz; {} GNSS fixes ({} NO_FIX skipped, {} with velocity), {} barometer, {} odometer readings",
+        p.path.display(),
+        1.0 / p.nominal_dt,
+        p.aids.fixes.len(),
+        p.aids.no_fix,
+        p.aids.fixes.iter().filter(|f| f.vel.is_some()).count(),
+        p.aids.baro.len(),
+        p.aids.odometer.len()
+    );
+    if p.aids.unmatched_velocities > 0 {
+        eprintln!(
+            "warning: {}: {} velocity messages have no fix at the same stamp and are not used",
+            p.path.display(),
+            p.aids.unmatched_velocities
+        );
+    }
+}
+
+/// `schuler nav --bag`.
+pub fn run(mut plan: NavPlan, args: &BagArgs) -> Result<()> {
+    let Some(path) = &args.bag else {
+        bail!("--bag is missing");
+    };
+    let started = Instant::now();
+    let options = read_options(&plan, args, plan.axes_given)?;
+    let bag = plan_bag(path, &options)?;
+    describe(&bag);
+    plan.aiding.bag = Some(bag.aids.clone());
+    let mut noise = filter_grade(&plan).noise()?;
+    if let Some((arw, vrw)) = bag.imu_noise {
+        // The flags override the covariances (applied in resolve).
+        noise.arw = arw;
+        noise.vrw = vrw;
+        eprintln!(
+            "{}: IMU noise from its covariances: ARW {:.4} deg/sqrt(h), VRW {:.4} m/s/sqrt(h) (largest axis; --arw, --vrw override)",
+            path.display(),
+            arw.max().to_degrees() * 60.0,
+            vrw.max() * 60.0
+        );
+    }
+    let mut aiding = plan.aiding.resolve(noise)?;
+    let mut samples = bag.imu_samples()?;
+    let bar = ProgressBar::hidden();
+    let summary = navigate_samples(&plan, &mut aiding, &mut samples, &bar, |_| {})?;
+    let secs = started.elapsed().as_secs_f64();
+    print_summary(&plan, aiding.as_ref(), &summary, secs)
+}
+
+/// [`plan`] with the error as anyhow's.
+fn plan_bag(path: &std::path::Path, options: &BagReadOptions) -> Result<BagPlan> {
+    Ok(plan(path, options)?)
+}
