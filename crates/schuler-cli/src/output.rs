@@ -72,6 +72,25 @@ fn heading_0_2pi(e: &Euler) -> f64 {
     }
 }
 
+/// A state's fields as `nav.txt` prints them, before rounding: latitude and longitude
+/// [deg] (longitude in [-180, 180)), height [m], velocity north, east, down [m/s],
+/// roll, pitch [deg] and yaw [deg, in [0, 360)]. For front ends that hand numbers
+/// over instead of text (the Python package).
+pub fn nav_fields(s: &NavState) -> [f64; 9] {
+    let r = Row::of(s);
+    [
+        r.lat_deg,
+        r.lon_deg,
+        r.h,
+        r.v[0],
+        r.v[1],
+        r.v[2],
+        r.roll_deg,
+        r.pitch_deg,
+        r.yaw_deg,
+    ]
+}
+
 /// One navigation epoch in output units.
 struct Row {
     lat_deg: f64,

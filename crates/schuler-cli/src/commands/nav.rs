@@ -14,7 +14,7 @@
 //! it, back to NED below `auto_latitude − auto_hysteresis` (defaults 75° and 0.5°),
 //! in free and aided runs alike (the filter is carried across the hand-over).
 
-use crate::aided::{Aiding, AidingOptions};
+use crate::aided::{Aiding, AidingOptions, GivenReadings};
 use crate::alignment::AlignOptions;
 use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
@@ -483,6 +483,27 @@ impl Begin<'_> {
     }
 }
 
+/// The run's aiding, if any: the options resolved (files read, or the `given`
+/// readings) with the noise model of `--imu-grade`.
+pub fn resolve_aiding(
+    alignment: &AlignOptions,
+    aiding: &AidingOptions,
+    given: GivenReadings,
+) -> Result<Option<Aiding>> {
+    // --imu-grade serves the alignment and the filter alike. Its default is
+    // navigation grade for alignment (gyrocompassing needs it) but tactical for the
+    // filter: an optimistic noise model makes the gate refuse good fixes, a
+    // pessimistic one only costs a little accuracy.
+    let grade = alignment
+        .imu_grade
+        .unwrap_or(if aiding.any() || given.any() {
+            GradeChoice::Tactical
+        } else {
+            GradeChoice::Navigation
+        });
+    aiding.resolve_with(grade.noise()?, given)
+}
+
 /// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
 /// [`crate::commands::run_nav`]).
 pub fn run(args: NavArgs) -> Result<()> {
@@ -493,16 +514,7 @@ pub fn run(args: NavArgs) -> Result<()> {
         alignment,
         aiding: aiding_opts,
     } = parse_nav_args(args)?;
-    // --imu-grade serves the alignment and the filter alike. Its default is
-    // navigation grade for alignment (gyrocompassing needs it) but tactical for the
-    // filter: an optimistic noise model makes the gate refuse good fixes, a
-    // pessimistic one only costs a little accuracy.
-    let grade = alignment.imu_grade.unwrap_or(if aiding_opts.any() {
-        GradeChoice::Tactical
-    } else {
-        GradeChoice::Navigation
-    });
-    let mut aiding: Option<Aiding> = aiding_opts.resolve(grade.noise()?)?;
+    let mut aiding = resolve_aiding(&alignment, &aiding_opts, GivenReadings::default())?;
     let started = Instant::now();
     let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
