@@ -54,8 +54,8 @@ pub fn read_gnss<'py>(
         c.push(
             f.t,
             &[
-                p.lat.to_degrees(),
-                p.lon.to_degrees(),
+                degrees_back(p.lat),
+                degrees_back(p.lon),
                 p.h,
                 s.x,
                 s.y,
@@ -70,6 +70,22 @@ pub fn read_gnss<'py>(
         );
     }
     c.take_dict(py)
+}
+
+/// `rad` in degrees, chosen among the neighbours of `rad.to_degrees()` (within 4
+/// ulps) so that `to_radians` gives `rad` back where one does: a table read here and
+/// given to `navigate` then holds the reader's own fixes, bit for bit.
+fn degrees_back(rad: f64) -> f64 {
+    let d = rad.to_degrees();
+    let mut candidates = [d; 9];
+    for k in 1..5 {
+        candidates[2 * k - 1] = (0..k).fold(d, |x, _| x.next_up());
+        candidates[2 * k] = (0..k).fold(d, |x, _| x.next_down());
+    }
+    candidates
+        .into_iter()
+        .find(|x| x.to_radians() == rad)
+        .unwrap_or(d)
 }
 
 /// Barometer readings of `path` (`t,h_m` CSV or `t h` text): columns `t_s`, `h_m`.

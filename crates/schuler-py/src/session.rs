@@ -49,10 +49,16 @@ impl PySession {
 #[pymethods]
 impl PySession {
     /// A session configured by `schuler nav`'s `flags` (an `--imu` placeholder among
-    /// them; aids are pushed, not read).
+    /// them; aids are pushed, not read); `gnss`, `baro`: such aids will be pushed (the
+    /// filter and its barometer state are set up for them).
     #[new]
-    fn new(py: Python<'_>, flags: Vec<String>) -> PyResult<Self> {
-        let plan = Plan::new(&flags, GivenReadings::default()).py_err(py)?;
+    #[pyo3(signature = (flags, gnss=false, baro=false))]
+    fn new(py: Python<'_>, flags: Vec<String>, gnss: bool, baro: bool) -> PyResult<Self> {
+        let given = GivenReadings {
+            fixes: gnss.then(Vec::new),
+            baro: baro.then(Vec::new),
+        };
+        let plan = Plan::new(&flags, given).py_err(py)?;
         let session = AnySession::open(&plan).py_err(py)?;
         Ok(Self {
             open: Some((session, Tables::default())),

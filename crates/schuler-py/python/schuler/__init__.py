@@ -270,15 +270,17 @@ def navigate(
 
 class Session:
     """A navigation session fed sample by sample or in blocks (live data, custom
-    loops). ``options`` as :func:`navigate`'s (aids are pushed, not read from files).
+    loops). ``options`` as :func:`navigate`'s (aids are pushed, not read from files);
+    ``gnss=True``, ``baro=True`` set the filter up for the fixes and heights that will
+    be pushed (the vehicle aids' options, ``nhc=True`` and so on, likewise).
 
     Aids pushed before the IMU reaches their time are applied at their own time;
     ``take()`` returns what was produced since the last call, ``finish()`` the rest
     with ``smoothed`` and ``summary``.
     """
 
-    def __init__(self, **options: Any) -> None:
-        self._native = _schuler.Session(_flags(options) + ["--imu=<session>"])
+    def __init__(self, gnss: bool = False, baro: bool = False, **options: Any) -> None:
+        self._native = _schuler.Session(_flags(options) + ["--imu=<session>"], gnss, baro)
 
     def push_imu(self, t: float, dtheta: Sequence[float], dvel: Sequence[float], dt: Optional[float] = None) -> None:
         """One IMU sample: interval end ``t`` [s], increments ``dtheta`` [rad] and
