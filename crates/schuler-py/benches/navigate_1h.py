@@ -1,5 +1,5 @@
-"""Benchmark: navigate 1 h at 200 Hz with 1-Hz GNSS (21-state filter with scale
-factors off, output at 1 Hz) from numpy arrays, against `schuler nav` on the same
+"""Benchmark: navigate 1 h at 200 Hz with 1-Hz GNSS (the filter with scale
+factors off: 15 states; output at 1 Hz) from numpy arrays, against `schuler nav` on the same
 files; both pinned to one core (taskset) when available, best of N runs.
 
     python benches/navigate_1h.py [--runs 5]
