@@ -3,13 +3,16 @@
 //! Python side (`python/schuler/`) turns keyword arguments into the CLI's flags and
 //! the dicts of numpy arrays returned here into pandas DataFrames.
 
+mod allan;
 mod arrays;
 mod columns;
+mod compare;
 mod errors;
 mod options;
 mod readers;
 mod run;
 mod session;
+mod simulate;
 
 use arrays::ImuArrays;
 use errors::IntoPy;
@@ -112,6 +115,9 @@ fn _schuler(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(readers::read_gnss, m)?)?;
     m.add_function(wrap_pyfunction!(readers::read_baro, m)?)?;
     m.add_function(wrap_pyfunction!(readers::read_nav, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(allan::allan, m)?)?;
     m.add_class::<session::PySession>()?;
     m.add("SchulerError", m.py().get_type::<errors::SchulerError>())?;
     m.add("InputError", m.py().get_type::<errors::InputError>())?;

@@ -26,6 +26,7 @@ Errors: bad input data raise :class:`InputError` (a ``ValueError``) with ``path`
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
@@ -37,15 +38,20 @@ from . import _schuler
 from ._schuler import InputError, SchulerError
 
 __all__ = [
+    "Comparison",
+    "allan",
     "InputError",
     "NavResult",
     "SchulerError",
     "Session",
+    "SimResult",
+    "compare",
     "navigate",
     "read_baro",
     "read_gnss",
     "read_imu",
     "read_nav",
+    "simulate",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -308,3 +314,103 @@ class Session:
     def finish(self) -> NavResult:
         """Ends the session: the remaining tables, ``smoothed`` and ``summary``."""
         return NavResult._of(self._native.finish())
+
+
+@dataclass
+class SimResult:
+    """What :func:`simulate` gives, as DataFrames (the data of ``schuler simulate``'s
+    files): ``imu`` (measured samples, :func:`read_imu`'s columns), ``truth`` (the
+    exact trajectory at every IMU sample: :func:`read_nav`'s columns, then the true
+    ``w_*_radps`` and ``f_*_mps2`` in body axes), ``gnss`` (:func:`read_gnss`'s columns
+    and ``outlier``; None without ``[gnss]``), ``baro`` (``t_s``, ``h_m``,
+    ``outlier``; None without ``[baro]``), ``sensor_errors`` (the true biases and
+    scale factors once a second, ``imu_err.txt``'s units) and ``scenario`` (every
+    parameter used, seed included, as TOML)."""
+
+    imu: pd.DataFrame
+    truth: pd.DataFrame
+    gnss: Optional[pd.DataFrame]
+    baro: Optional[pd.DataFrame]
+    sensor_errors: pd.DataFrame
+    scenario: str
+
+
+def simulate(scenario: Union[PathLike, str, Mapping[str, Any]]) -> SimResult:
+    """Simulate a ``schuler simulate`` scenario: a ``.toml`` file, TOML text, or a dict
+    of the same keys (e.g. ``{"seed": 7, "start": {...}, "motion": [...], "imu":
+    {"rate_hz": 200, "preset": "tactical"}, "gnss": {...}}``). The same scenario and
+    seed give the same bits. The GIL is released while it runs."""
+    if isinstance(scenario, Mapping):
+        d = _schuler.simulate_scenario(json.dumps(scenario), "json")
+    elif isinstance(scenario, os.PathLike) or (
+        isinstance(scenario, str) and "\n" not in scenario and scenario.strip().endswith(".toml")
+    ):
+        d = _schuler.simulate_scenario(path=os.fspath(scenario))
+    else:
+        d = _schuler.simulate_scenario(scenario, "toml")
+    opt = lambda k: None if d.get(k) is None else _frame(d[k])  # noqa: E731
+    return SimResult(
+        imu=_frame(d["imu"]),
+        truth=_frame(d["truth"]),
+        gnss=opt("gnss"),
+        baro=opt("baro"),
+        sensor_errors=_frame(d["sensor_errors"]),
+        scenario=d["scenario"],
+    )
+
+
+#: Columns of a navigation table (:func:`read_nav`, ``NavResult.trajectory``).
+NAV_COLUMNS = ("t_s", "lat_deg", "lon_deg", "h_m", "vn_mps", "ve_mps", "vd_mps", "roll_deg", "pitch_deg", "yaw_deg")
+
+
+@dataclass
+class Comparison:
+    """What :func:`compare` gives: ``errors`` per matched epoch (``errors.csv``:
+    position north, east, down and horizontal [m] along the truth's NED axes,
+    velocity [m/s], roll, pitch, yaw [deg], ``interpolated``) and ``summary``
+    (``compare.json``: matched epochs, per quantity RMS, max, 95 %, mean, CEP/CEP95 [m],
+    outage maxima)."""
+
+    errors: pd.DataFrame
+    summary: Dict[str, Any]
+
+
+def _nav_input(x: Union[PathLike, Table]):
+    if isinstance(x, (str, os.PathLike)):
+        return os.fspath(x)
+    return _columns(x, NAV_COLUMNS, "navigation table")
+
+
+def compare(
+    nav: Union[PathLike, Table],
+    truth: Union[PathLike, Table],
+    start: Optional[float] = None,
+    end: Optional[float] = None,
+    outages: Sequence[Sequence[float]] = (),
+) -> Comparison:
+    """Errors of a navigation result against a truth, as ``schuler compare``: both
+    files (KF-GINS text, ``nav.csv``) or tables of :func:`read_nav`'s columns; matched
+    by time (the truth interpolated where its epochs differ) within ``[start, end]``
+    [s]; ``outages`` as ``(from_s, to_s)`` windows for the outage maxima."""
+    d = _schuler.compare(_nav_input(nav), _nav_input(truth), start, end, [tuple(map(float, o)) for o in outages])
+    errors = _frame(d["errors"])
+    errors["interpolated"] = errors["interpolated"].astype(bool)
+    return Comparison(errors=errors, summary=json.loads(d["summary"]))
+
+
+def allan(imu: Union[PathLike, Table], per_decade: float = 10.0, max_tau: Optional[float] = None, **options: Any) -> pd.DataFrame:
+    """Overlapping Allan deviations of a static IMU log's six channels, as ``schuler
+    allan`` computes them: ``per_decade`` cluster times a decade up to ``max_tau`` [s]
+    (default a tenth of the log). ``imu``: a file (read with the IMU input
+    ``options``) or a table as :func:`navigate`'s. Columns ``tau_s``, ``m`` (cluster
+    size), ``gyro_{x,y,z}_radps``, ``accel_{x,y,z}_mps2``."""
+    if isinstance(imu, (str, os.PathLike)):
+        d = _schuler.allan(path=os.fspath(imu), flags=_flags(options), per_decade=per_decade, max_tau=max_tau)
+    else:
+        if options:
+            raise TypeError("reading options apply to files only")
+        cols, dt = _imu(imu)
+        d = _schuler.allan(imu=cols, imu_dt=dt, per_decade=per_decade, max_tau=max_tau)
+    out = _frame(d)
+    out["m"] = out["m"].astype(np.int64)
+    return out

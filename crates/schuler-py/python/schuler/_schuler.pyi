@@ -47,3 +47,22 @@ class Session:
     def push_baro(self, t: float, h_m: float) -> None: ...
     def take(self) -> Dict[str, Any]: ...
     def finish(self) -> Dict[str, Any]: ...
+
+def simulate_scenario(
+    text: Optional[str] = None, format: str = "toml", path: Optional[str] = None
+) -> Dict[str, Any]: ...
+def compare(
+    nav: Any,
+    truth: Any,
+    start: Optional[float] = None,
+    end: Optional[float] = None,
+    outages: Sequence[Tuple[float, float]] = (),
+) -> Dict[str, Any]: ...
+def allan(
+    path: Optional[str] = None,
+    flags: List[str] = ...,
+    imu: Optional[Sequence[F64]] = None,
+    imu_dt: Optional[F64] = None,
+    per_decade: float = 10.0,
+    max_tau: Optional[float] = None,
+) -> Dict[str, F64]: ...
