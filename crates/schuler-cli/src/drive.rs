@@ -15,7 +15,7 @@ use schuler::filter::SensorEstimates;
 use schuler::filter::integration::SkipReason;
 use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
-use schuler::session::{Epoch, Event, Finished, Session};
+use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session};
 use schuler::units::{DEG_PER_H, MGAL, PPM};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -77,6 +77,102 @@ pub fn imu_err_row(e: &SensorEstimates) -> Vec<f64> {
     row.extend(e.gyro_scale.iter().map(|x| x / PPM));
     row.extend(e.accel_scale.iter().map(|x| x / PPM));
     row
+}
+
+/// The KF-GINS STD columns after time: position [m] and velocity [m/s] north, east,
+/// down, attitude roll, pitch, yaw [deg], gyro bias [deg/h], accelerometer bias [mGal],
+/// gyro and accelerometer scale factors [ppm].
+pub fn std_row(f: &FilterEpoch) -> Vec<f64> {
+    let [sp, sv, sa] = f.nav_std;
+    let [gb, ab, gs, as_] = f.sensor_std;
+    let mut row = Vec::with_capacity(21);
+    row.extend_from_slice(sp.as_slice());
+    row.extend_from_slice(sv.as_slice());
+    row.extend(sa.iter().map(|x| x.to_degrees()));
+    row.extend(gb.iter().map(|x| x / DEG_PER_H));
+    row.extend(ab.iter().map(|x| x / MGAL));
+    row.extend(gs.iter().map(|x| x / PPM));
+    row.extend(as_.iter().map(|x| x / PPM));
+    row
+}
+
+/// A measurement the filter did not use, as `rejected.csv` lists it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refusal {
+    /// Time [s].
+    pub t: f64,
+    /// The measurement kind (`gnss_position`, ...).
+    pub measurement: String,
+    /// Why it was not used, or how it was used after all (a gate reset).
+    pub reason: String,
+    /// Its normalized innovation squared, when tested.
+    pub nis: Option<f64>,
+    /// The gate's threshold, when refused by it.
+    pub threshold: Option<f64>,
+}
+
+impl Refusal {
+    /// The refusal an event reports, if it is one (refused by the gate, outside the
+    /// IMU data, accepted by a gate reset, late, ignored).
+    pub fn of(e: &Event) -> Option<Self> {
+        let r = |t: f64, m: &dyn std::fmt::Display, reason: String, nis, threshold| Self {
+            t,
+            measurement: m.to_string(),
+            reason,
+            nis,
+            threshold,
+        };
+        Some(match e {
+            Event::Refused(x) => r(
+                x.t,
+                &x.kind,
+                "chi-square gate".into(),
+                Some(x.rejection.nis),
+                Some(x.rejection.threshold),
+            ),
+            Event::Skipped(k) => {
+                let why = match k.reason {
+                    SkipReason::BeforeImu => "before the IMU data",
+                    SkipReason::AfterImu => "after the IMU data",
+                };
+                r(k.t, &k.kind, why.into(), None, None)
+            }
+            Event::GateReset { t, nis } => r(
+                *t,
+                &"gnss_position",
+                "accepted without the gate after consecutive refusals (filter reset)".into(),
+                Some(*nis),
+                None,
+            ),
+            Event::Late {
+                t,
+                kind,
+                integrated_to,
+            } => r(
+                *t,
+                kind,
+                format!("arrived after its sample was integrated (at {integrated_to})"),
+                None,
+                None,
+            ),
+            Event::Ignored { t, kind, reason } => r(*t, kind, (*reason).into(), None, None),
+            Event::Measurement(_) | Event::Handover(_) | Event::Envelope { .. } => return None,
+        })
+    }
+
+    /// Its line of `rejected.csv`: `t,measurement,reason,nis,threshold` (empty fields
+    /// for what it lacks).
+    pub fn csv_line(&self) -> String {
+        let opt = |x: Option<f64>| x.map(|x| x.to_string()).unwrap_or_default();
+        format!(
+            "{},{},{},{},{}\n",
+            self.t,
+            self.measurement,
+            self.reason,
+            opt(self.nis),
+            opt(self.threshold)
+        )
+    }
 }
 
 /// The filter's output files.
@@ -159,17 +255,7 @@ impl Outputs {
             self.heading_settled = Some((e.state.t, e.state.euler().heading_0_2pi()));
         }
         if let (Some(files), Some(f)) = (self.filter.as_mut(), &e.filter) {
-            let [sp, sv, sa] = f.nav_std;
-            let [gb, ab, gs, as_] = f.sensor_std;
-            let mut row = Vec::with_capacity(21);
-            row.extend_from_slice(sp.as_slice());
-            row.extend_from_slice(sv.as_slice());
-            row.extend(sa.iter().map(|x| x.to_degrees()));
-            row.extend(gb.iter().map(|x| x / DEG_PER_H));
-            row.extend(ab.iter().map(|x| x / MGAL));
-            row.extend(gs.iter().map(|x| x / PPM));
-            row.extend(as_.iter().map(|x| x / PPM));
-            files.std.row(e.state.t, &row)?;
+            files.std.row(e.state.t, &std_row(f))?;
             files.err.row(e.state.t, &imu_err_row(&f.estimates))?;
         }
         Ok(())
@@ -188,41 +274,13 @@ impl Outputs {
         let Some(files) = self.filter.as_mut() else {
             return Ok(());
         };
-        let row = match e {
-            Event::Measurement(i) => return files.innovations.push(&i),
-            Event::Refused(r) => (
-                r.t,
-                format!(
-                    "{},{},chi-square gate,{},{}\n",
-                    r.t, r.kind, r.rejection.nis, r.rejection.threshold
-                ),
-            ),
-            Event::Skipped(k) => {
-                let why = match k.reason {
-                    SkipReason::BeforeImu => "before the IMU data",
-                    SkipReason::AfterImu => "after the IMU data",
-                };
-                (k.t, format!("{},{},{why},,\n", k.t, k.kind))
-            }
-            Event::GateReset { t, nis } => (
-                t,
-                format!(
-                    "{t},gnss_position,accepted without the gate after consecutive refusals (filter reset),{nis},\n"
-                ),
-            ),
-            Event::Late {
-                t,
-                kind,
-                integrated_to,
-            } => (
-                t,
-                format!(
-                    "{t},{kind},arrived after its sample was integrated (at {integrated_to}),,\n"
-                ),
-            ),
-            Event::Ignored { t, kind, reason } => (t, format!("{t},{kind},{reason},,\n")),
-            Event::Handover(_) | Event::Envelope { .. } => return Ok(()),
+        if let Event::Measurement(i) = &e {
+            return files.innovations.push(i);
+        }
+        let Some(r) = Refusal::of(&e) else {
+            return Ok(());
         };
+        let row = (r.t, r.csv_line());
         files.refused.push(row);
         Ok(())
     }

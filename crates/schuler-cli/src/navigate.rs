@@ -86,14 +86,13 @@ pub struct RunSummary {
 }
 
 /// The session from `start` with the settings' configuration (aided: with the truth
-/// and every aid pushed) and the outputs it writes into `settings.out`: the
-/// navigation result and, aided, the filter's files.
-fn open<E: EarthModel>(
+/// and every aid pushed); configuration errors name the flag.
+pub fn open_session<E: EarthModel>(
     earth: E,
     settings: &NavSettings,
     aiding: Option<&Aiding>,
     start: Start,
-) -> Result<(Session<E>, Outputs)> {
+) -> Result<Session<E>> {
     let mut session =
         Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
     if let Some(a) = aiding {
@@ -102,6 +101,18 @@ fn open<E: EarthModel>(
             session.push(aid)?;
         }
     }
+    Ok(session)
+}
+
+/// [`open_session`] and the outputs it writes into `settings.out`: the navigation
+/// result and, aided, the filter's files.
+fn open<E: EarthModel>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+    start: Start,
+) -> Result<(Session<E>, Outputs)> {
+    let session = open_session(earth, settings, aiding, start)?;
     Ok((session, outputs(&earth, settings, aiding)?))
 }
 

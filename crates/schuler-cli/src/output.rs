@@ -72,6 +72,25 @@ fn heading_0_2pi(e: &Euler) -> f64 {
     }
 }
 
+/// A state's fields as `nav.txt` prints them, before rounding: latitude and longitude
+/// [deg] (longitude in [-180, 180)), height [m], velocity north, east, down [m/s],
+/// roll, pitch [deg] and yaw [deg, in [0, 360)]. For front ends that hand numbers
+/// over instead of text (the Python package).
+pub fn nav_fields(s: &NavState) -> [f64; 9] {
+    let r = Row::of(s);
+    [
+        r.lat_deg,
+        r.lon_deg,
+        r.h,
+        r.v[0],
+        r.v[1],
+        r.v[2],
+        r.roll_deg,
+        r.pitch_deg,
+        r.yaw_deg,
+    ]
+}
+
 /// One navigation epoch in output units.
 struct Row {
     lat_deg: f64,
@@ -462,6 +481,23 @@ pub fn write_imu_text(
 pub const ERRORS_CSV_HEADER: &str = "t_sow,north_m,east_m,down_m,horizontal_m,vn_mps,ve_mps,\
 vd_mps,roll_deg,pitch_deg,yaw_deg,interpolated";
 
+/// An epoch's errors as `errors.csv` holds them after the time: position north, east,
+/// down and horizontal [m], velocity north, east, down [m/s], roll, pitch, yaw [deg].
+pub fn error_fields(e: &EpochErrors) -> [f64; 10] {
+    [
+        e.pos_n.x,
+        e.pos_n.y,
+        e.pos_n.z,
+        e.horizontal(),
+        e.v_n.x,
+        e.v_n.y,
+        e.v_n.z,
+        e.att.roll.to_degrees(),
+        e.att.pitch.to_degrees(),
+        e.att.yaw.to_degrees(),
+    ]
+}
+
 /// Writes `errors.csv`: one row per matched epoch, shortest round-trip numbers.
 pub fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
     let file =
@@ -473,18 +509,7 @@ pub fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
     for e in errors {
         line.clear();
         let _ = write!(line, "{}", e.t_sow);
-        for x in [
-            e.pos_n.x,
-            e.pos_n.y,
-            e.pos_n.z,
-            e.horizontal(),
-            e.v_n.x,
-            e.v_n.y,
-            e.v_n.z,
-            e.att.roll.to_degrees(),
-            e.att.pitch.to_degrees(),
-            e.att.yaw.to_degrees(),
-        ] {
+        for x in error_fields(e) {
             let _ = write!(line, ",{x}");
         }
         let _ = writeln!(line, ",{}", u8::from(e.interpolated));

@@ -69,6 +69,22 @@ pub struct Aiding {
     pub vehicle: VehicleReadings,
 }
 
+/// Aiding readings held in memory, in place of the files of `--gnss` and `--baro`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GivenReadings {
+    /// GNSS fixes in time order.
+    pub fixes: Option<Vec<GnssFix>>,
+    /// Barometer readings `(t, h)` [s, m].
+    pub baro: Option<Vec<(f64, f64)>>,
+}
+
+impl GivenReadings {
+    /// Whether any readings are given.
+    pub fn any(&self) -> bool {
+        self.fixes.is_some() || self.baro.is_some()
+    }
+}
+
 /// The outage test of `--outage-test`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutageTest {
@@ -407,17 +423,30 @@ impl AidingOptions {
     /// Load the aiding data and check every value; `None` without any aiding source
     /// ([`AidingOptions::any`]).
     pub fn resolve(&self, noise: schuler::filter::ImuNoise) -> Result<Option<Aiding>> {
-        if self.gnss.is_none() && self.gnss_vel.is_some() {
+        self.resolve_with(noise, GivenReadings::default())
+    }
+
+    /// [`AidingOptions::resolve`] with readings a caller holds in memory in place of
+    /// the files `--gnss` and `--baro` would name (the Python package's arrays); the
+    /// options that act on the readings (`--gnss-vel`, `--gnss-time-offset`,
+    /// `--outage-test`, `--baro-std`, ...) act on them alike.
+    pub fn resolve_with(
+        &self,
+        noise: schuler::filter::ImuNoise,
+        given: GivenReadings,
+    ) -> Result<Option<Aiding>> {
+        let has_gnss = self.gnss.is_some() || given.fixes.is_some();
+        if !has_gnss && self.gnss_vel.is_some() {
             bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
         }
         vehicle::check_dependencies(self)?;
-        if !self.any() {
+        if !(self.any() || given.any()) {
             return Ok(None);
         }
-        let mut fixes = self.fixes()?;
+        let mut fixes = self.fixes(given.fixes)?;
         let noise = self.noise(noise)?;
         let outage_test = self.outage_test(&mut fixes)?;
-        let (baro, baro_std) = self.baro()?;
+        let (baro, baro_std) = self.baro(given.baro)?;
         let (vehicle_cfg, vehicle) = vehicle::resolve(self, &noise)?;
         let mut integration = self.integration(noise)?;
         integration.baro = baro_std.map(|(_, bias)| (bias, 0.0));
@@ -456,21 +485,23 @@ impl AidingOptions {
 
     /// The GNSS fixes (the reader's warnings printed), with the velocities of
     /// `--gnss-vel` merged in and `--gnss-time-offset` added to their times.
-    fn fixes(&self) -> Result<Vec<GnssFix>> {
+    /// `given`: fixes in memory in place of the file.
+    pub fn fixes(&self, given: Option<Vec<GnssFix>>) -> Result<Vec<GnssFix>> {
         let vel_std =
             quantity("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
         if vel_std <= 0.0 {
             bail!("--gnss-vel-std must be positive");
         }
-        let mut fixes = match &self.gnss {
-            Some(gnss) => {
+        let mut fixes = match (given, &self.gnss) {
+            (Some(given), _) => given,
+            (None, Some(gnss)) => {
                 let log = read_gnss_log(gnss, &self.gnss_read_options(vel_std)?)?;
                 for w in &log.warnings {
                     eprintln!("warning: {}: {w}", gnss.display());
                 }
                 log.fixes
             }
-            None => self
+            (None, None) => self
                 .bag
                 .as_ref()
                 .map(|b| b.fixes.clone())
@@ -636,12 +667,13 @@ impl AidingOptions {
         }))
     }
 
-    /// The barometer's readings `(t, h)` and `(noise, bias prior)` standard
-    /// deviations [m].
-    fn baro(&self) -> Result<BaroInput> {
-        let readings = match (&self.baro, &self.bag) {
-            (Some(path), _) => crate::formats::gnss::read_baro(path)?,
-            (None, Some(bag)) if !bag.baro.is_empty() => bag.baro.clone(),
+    /// The barometer's readings `(t, h)` (`given`, or read from `--baro`, or the
+    /// bag's) and `(noise, bias prior)` standard deviations [m].
+    fn baro(&self, given: Option<Vec<(f64, f64)>>) -> Result<BaroInput> {
+        let readings = match (given, &self.baro, &self.bag) {
+            (Some(given), _, _) => given,
+            (None, Some(path), _) => crate::formats::gnss::read_baro(path)?,
+            (None, None, Some(bag)) if !bag.baro.is_empty() => bag.baro.clone(),
             _ => return Ok((Vec::new(), None)),
         };
         let std = quantity("baro-std", &self.baro_std, Dimension::Length)?.unwrap_or(0.5);

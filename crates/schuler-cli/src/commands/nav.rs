@@ -14,7 +14,7 @@
 //! it, back to NED below `auto_latitude − auto_hysteresis` (defaults 75° and 0.5°),
 //! in free and aided runs alike (the filter is carried across the hand-over).
 
-use crate::aided::{Aiding, AidingOptions};
+use crate::aided::{Aiding, AidingOptions, GivenReadings};
 use crate::alignment::AlignOptions;
 use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
@@ -529,14 +529,31 @@ impl Begin<'_> {
 }
 
 /// The filter's IMU grade: `--imu-grade`, else navigation grade for alignment
-/// (gyrocompassing needs it) but tactical for the filter: an optimistic noise model
-/// makes the gate refuse good fixes, a pessimistic one only costs a little accuracy.
-pub(crate) fn filter_grade(plan: &NavPlan) -> GradeChoice {
-    plan.alignment.imu_grade.unwrap_or(if plan.aiding.any() {
+/// (gyrocompassing needs it) but tactical for the filter (`aided`): an optimistic
+/// noise model makes the gate refuse good fixes, a pessimistic one only costs a
+/// little accuracy.
+fn grade(alignment: &AlignOptions, aided: bool) -> GradeChoice {
+    alignment.imu_grade.unwrap_or(if aided {
         GradeChoice::Tactical
     } else {
         GradeChoice::Navigation
     })
+}
+
+/// The filter's IMU grade of a plan ([`grade`]).
+pub(crate) fn filter_grade(plan: &NavPlan) -> GradeChoice {
+    grade(&plan.alignment, plan.aiding.any())
+}
+
+/// The run's aiding, if any: the options resolved (files read, or the `given`
+/// readings) with the noise model of `--imu-grade`.
+pub fn resolve_aiding(
+    alignment: &AlignOptions,
+    aiding: &AidingOptions,
+    given: GivenReadings,
+) -> Result<Option<Aiding>> {
+    let noise = grade(alignment, aiding.any() || given.any()).noise()?;
+    aiding.resolve_with(noise, given)
 }
 
 /// The run from an open IMU source: the start (given, aligned at rest, or from the

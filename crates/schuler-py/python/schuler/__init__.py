@@ -1,0 +1,416 @@
+"""schuler: inertial navigation from Python.
+
+A thin layer over the Rust library's navigation session and the ``schuler`` command
+line's readers and options: the same code computes both, so ``navigate`` gives the
+numbers ``schuler nav`` prints.
+
+Frames, names and units (for the whole package):
+
+* body axes front-right-down (FRD); navigation frame north-east-down (NED);
+* attitude as Z-Y-X Euler angles in the order roll, pitch, yaw, in degrees in tables
+  (yaw in [0, 360)); positions geodetic: latitude, longitude [deg], ellipsoidal
+  height [m] (WGS84 unless ``earth="sphere"``);
+* every table column carries its unit in its name: ``_s`` seconds, ``_deg`` degrees,
+  ``_rad`` radians, ``_m`` metres, ``_mps`` m/s, ``_degph`` deg/h, ``_mgal`` mGal,
+  ``_ppm`` parts per million;
+* IMU samples are increments over the interval ``(t - dt_s, t_s]``: angle
+  ``dtheta_*_rad`` and velocity ``dvel_*_mps``;
+* keyword options are ``schuler nav``'s flags with underscores
+  (``init_pos=(45.07, 7.68, 245)`` is ``--init-pos 45.07,7.68,245``; ``True`` turns a
+  switch on; strings with units as the CLI takes them, ``arw="0.1 deg/sqrt(h)"``).
+
+Errors: bad input data raise :class:`InputError` (a ``ValueError``) with ``path``,
+``line`` (1-based; for arrays the row) and ``field``; other refusals raise
+:class:`SchulerError`; an option the CLI does not have raises ``TypeError``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import pandas as pd
+
+from . import _schuler
+from ._schuler import InputError, SchulerError
+
+__all__ = [
+    "Comparison",
+    "allan",
+    "InputError",
+    "NavResult",
+    "SchulerError",
+    "Session",
+    "SimResult",
+    "compare",
+    "navigate",
+    "read_baro",
+    "read_gnss",
+    "read_imu",
+    "read_nav",
+    "simulate",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Table = Union[pd.DataFrame, Mapping[str, Any], np.ndarray]
+
+#: IMU columns after ``t_s`` and ``dt_s``: increments in FRD [rad, m/s].
+IMU_INCREMENTS = (
+    "dtheta_x_rad",
+    "dtheta_y_rad",
+    "dtheta_z_rad",
+    "dvel_x_mps",
+    "dvel_y_mps",
+    "dvel_z_mps",
+)
+#: GNSS columns: time, position, its standard deviations (required) ...
+GNSS_POSITION = ("t_s", "lat_deg", "lon_deg", "h_m", "std_n_m", "std_e_m", "std_d_m")
+#: ... and velocity with its standard deviations (optional; NaN: none).
+GNSS_VELOCITY = ("vn_mps", "ve_mps", "vd_mps", "std_vn_mps", "std_ve_mps", "std_vd_mps")
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, (bool, np.bool_)):
+        raise TypeError("switches take True or False alone")
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, os.PathLike):
+        return os.fspath(v)
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return ",".join(_value(x) for x in v)
+    raise TypeError(f"cannot pass {type(v).__name__} as an option value")
+
+
+def _flags(options: Mapping[str, Any]) -> List[str]:
+    """``schuler nav``'s flags of keyword options (None and False are left out)."""
+    out = []
+    for name, v in options.items():
+        if v is None or v is False:
+            continue
+        flag = "--" + name.replace("_", "-")
+        out.append(flag if v is True else f"{flag}={_value(v)}")
+    return out
+
+
+def _frame(columns: Mapping[str, Any]) -> pd.DataFrame:
+    return pd.DataFrame(dict(columns))
+
+
+def _f64(x: Any) -> np.ndarray:
+    """A float64 view of ``x`` (a copy only if it is of another type)."""
+    return np.asarray(x, dtype=np.float64)
+
+
+def _columns(table: Table, names: Sequence[str], what: str) -> List[np.ndarray]:
+    """The columns ``names`` of a DataFrame, a mapping or a 2-D array (by position)."""
+    if isinstance(table, np.ndarray):
+        a = _f64(table)
+        if a.ndim != 2 or a.shape[1] < len(names):
+            raise ValueError(f"{what}: a 2-D array of at least {len(names)} columns ({', '.join(names)}) expected, got shape {a.shape}")
+        return [a[:, k] for k in range(len(names))]
+    missing = [n for n in names if n not in table]
+    if missing:
+        raise ValueError(f"{what}: missing column(s) {', '.join(missing)} (expected {', '.join(names)})")
+    return [_f64(table[n]) for n in names]
+
+
+def _imu(imu: Table):
+    """IMU columns ``t_s, dtheta..., dvel...`` and ``dt_s`` if given. A 2-D array holds
+    ``t, dtheta_xyz, dvel_xyz`` (7 columns, the KF-GINS layout) or ``t, dt, ...`` (8)."""
+    if isinstance(imu, np.ndarray) and imu.ndim == 2 and imu.shape[1] == 8:
+        a = _f64(imu)
+        return [a[:, 0]] + [a[:, k] for k in range(2, 8)], a[:, 1]
+    cols = _columns(imu, ("t_s",) + IMU_INCREMENTS, "imu")
+    dt = None
+    if not isinstance(imu, np.ndarray) and "dt_s" in imu:
+        dt = _f64(imu["dt_s"])
+    return cols, dt
+
+
+def _gnss(gnss: Table) -> List[np.ndarray]:
+    cols = _columns(gnss, GNSS_POSITION, "gnss")
+    has_vel = (
+        isinstance(gnss, np.ndarray) and gnss.ndim == 2 and gnss.shape[1] >= 13
+    ) or (not isinstance(gnss, np.ndarray) and all(n in gnss for n in GNSS_VELOCITY))
+    if has_vel:
+        cols += _columns(gnss, GNSS_POSITION + GNSS_VELOCITY, "gnss")[7:]
+    return cols
+
+
+def _baro(baro: Table):
+    t, h = _columns(baro, ("t_s", "h_m"), "baro")
+    return (t, h)
+
+
+def read_imu(path: PathLike, **options: Any) -> pd.DataFrame:
+    """IMU samples of a log as ``schuler nav --imu`` reads it.
+
+    ``options``: the IMU input flags (``imu_format``, ``imu_layout``, ``imu_rate``,
+    ``imu_columns``, ``gyro_unit``, ``accel_unit``, ``imu_time_unit``,
+    ``imu_time_offset``, ``imu_axes``, ``imu_rotation``, ``no_layout_check``) and
+    ``start``, ``end`` [s]. Columns: ``t_s`` (interval end), ``dt_s``,
+    ``dtheta_{x,y,z}_rad``, ``dvel_{x,y,z}_mps`` (vehicle FRD axes).
+    """
+    return _frame(_schuler.read_imu(os.fspath(path), _flags(options)))
+
+
+def read_gnss(path: PathLike, **options: Any) -> pd.DataFrame:
+    """GNSS fixes of a log as ``schuler nav --gnss`` reads it (KF-GINS text, CSV, NMEA,
+    RTKLIB .pos).
+
+    ``options``: ``gnss_format``, ``gnss_std``, ``gnss_min_quality``,
+    ``gnss_time_offset``, ``gnss_vel``, ``gnss_vel_std``. Columns: ``t_s``,
+    ``lat_deg``, ``lon_deg``, ``h_m``, ``std_{n,e,d}_m``, ``v{n,e,d}_mps`` and
+    ``std_v{n,e,d}_mps`` (NaN where a fix has no velocity).
+    """
+    return _frame(_schuler.read_gnss(os.fspath(path), _flags(options)))
+
+
+def read_baro(path: PathLike) -> pd.DataFrame:
+    """Barometric heights (``baro.csv`` of ``schuler simulate``, or ``t h`` rows):
+    columns ``t_s``, ``h_m``."""
+    return _frame(_schuler.read_baro(os.fspath(path)))
+
+
+def read_nav(path: PathLike) -> pd.DataFrame:
+    """A navigation result or truth (KF-GINS text such as ``nav.txt``, or ``nav.csv``):
+    ``t_s``, ``lat_deg``, ``lon_deg``, ``h_m``, ``v{n,e,d}_mps``, ``roll_deg``,
+    ``pitch_deg``, ``yaw_deg`` (yaw in [0, 360))."""
+    return _frame(_schuler.read_nav(os.fspath(path)))
+
+
+@dataclass
+class NavResult:
+    """What a navigation run gives, as DataFrames.
+
+    ``trajectory``: ``nav.txt``'s columns at the output epochs. With a filter (aiding):
+    ``std`` (``std.txt``: position [m], velocity [m/s], attitude [deg], sensor errors
+    [deg/h, mGal, ppm]), ``sensor_errors`` (``imu_err.txt``), ``innovations`` (every
+    tested measurement: ``kind``, ``accepted``, ``dof``, ``nis``, innovation ``z_*`` and
+    predicted ``sigma_*``, NaN past ``dof``), ``refused`` (``rejected.csv``: time,
+    measurement, reason, NIS, threshold), ``smoothed`` (with ``smooth=True``: the
+    Rauch-Tung-Striebel trajectory with its standard deviations, else None),
+    ``summary`` (counts, mean NIS per degree of freedom, hand-overs) and ``warnings``.
+    """
+
+    trajectory: pd.DataFrame
+    std: pd.DataFrame
+    sensor_errors: pd.DataFrame
+    innovations: pd.DataFrame
+    refused: pd.DataFrame
+    smoothed: Optional[pd.DataFrame] = None
+    summary: Dict[str, Any] = field(default_factory=dict)
+    warnings: List[str] = field(default_factory=list)
+
+    @classmethod
+    def _of(cls, d: Dict[str, Any]) -> "NavResult":
+        inn = dict(d["innovations"])
+        kind = inn.pop("kind")
+        innovations = _frame(inn)
+        innovations.insert(1, "kind", pd.Series(kind, dtype=object))
+        if len(innovations):
+            innovations["accepted"] = innovations["accepted"].astype(bool)
+            innovations["dof"] = innovations["dof"].astype(np.int64)
+        smoothed = d.get("smoothed")
+        return cls(
+            trajectory=_frame(d["trajectory"]),
+            std=_frame(d["std"]),
+            sensor_errors=_frame(d["sensor_errors"]),
+            innovations=innovations,
+            refused=_frame(d["refused"]),
+            smoothed=None if smoothed is None else _frame(smoothed),
+            summary=d.get("summary", {}),
+            warnings=list(d.get("warnings", [])),
+        )
+
+
+def navigate(
+    imu: Union[PathLike, Table],
+    gnss: Union[PathLike, Table, None] = None,
+    baro: Union[PathLike, Table, None] = None,
+    **options: Any,
+) -> NavResult:
+    """Navigate an IMU log, free-inertial or aided, as ``schuler nav`` does.
+
+    ``imu``: a file path (read with the IMU input options), a DataFrame or mapping with
+    ``t_s``, ``dtheta_*_rad``, ``dvel_*_mps`` (and ``dt_s``; else each interval is the
+    time difference, the first sample's the first difference), or a 2-D float array of
+    the KF-GINS layout ``t, dtheta_xyz, dvel_xyz`` (or ``t, dt, ...``). Arrays are read
+    in place (no copy when already float64); the layout check of files is not applied.
+
+    ``gnss``: a path or a table of :func:`read_gnss`'s columns (velocity optional).
+    ``baro``: a path or a table with ``t_s``, ``h_m``.
+
+    ``options``: ``schuler nav``'s flags with underscores, e.g. ``init_pos=(lat_deg,
+    lon_deg, h_m)``, ``init_vel=(vn, ve, vd)`` [m/s], ``init_att=(roll, pitch, yaw)``
+    [deg], ``output_rate`` [Hz], ``start``/``end`` [s], ``lever_arm=(x, y, z)`` [m,
+    FRD], ``imu_grade="tactical"``, ``gate``, ``arw="0.1 deg/sqrt(h)"``,
+    ``scale_factors=True``, ``smooth=True``, ``mechanization``, ``earth``, ...
+    The GIL is released while the run goes on.
+    """
+    flags = _flags(options)
+    kwargs: Dict[str, Any] = {}
+    if isinstance(imu, (str, os.PathLike)):
+        flags.append(f"--imu={os.fspath(imu)}")
+    else:
+        cols, dt = _imu(imu)
+        flags.append("--imu=<imu array>")
+        kwargs.update(imu=cols, imu_dt=dt)
+    if isinstance(gnss, (str, os.PathLike)):
+        flags.append(f"--gnss={os.fspath(gnss)}")
+    elif gnss is not None:
+        kwargs["gnss"] = _gnss(gnss)
+    if isinstance(baro, (str, os.PathLike)):
+        flags.append(f"--baro={os.fspath(baro)}")
+    elif baro is not None:
+        kwargs["baro"] = _baro(baro)
+    return NavResult._of(_schuler.navigate(flags, **kwargs))
+
+
+class Session:
+    """A navigation session fed sample by sample or in blocks (live data, custom
+    loops). ``options`` as :func:`navigate`'s (aids are pushed, not read from files);
+    ``gnss=True``, ``baro=True`` set the filter up for the fixes and heights that will
+    be pushed (the vehicle aids' options, ``nhc=True`` and so on, likewise).
+
+    Aids pushed before the IMU reaches their time are applied at their own time;
+    ``take()`` returns what was produced since the last call, ``finish()`` the rest
+    with ``smoothed`` and ``summary``.
+    """
+
+    def __init__(self, gnss: bool = False, baro: bool = False, **options: Any) -> None:
+        self._native = _schuler.Session(_flags(options) + ["--imu=<session>"], gnss, baro)
+
+    def push_imu(self, t: float, dtheta: Sequence[float], dvel: Sequence[float], dt: Optional[float] = None) -> None:
+        """One IMU sample: interval end ``t`` [s], increments ``dtheta`` [rad] and
+        ``dvel`` [m/s] (FRD); ``dt`` [s] defaults to the time since the last sample
+        (required for the first)."""
+        self._native.push_imu(float(t), [float(x) for x in dtheta], [float(x) for x in dvel], dt)
+
+    def push_imu_block(self, imu: Table) -> None:
+        """A block of IMU samples, as :func:`navigate`'s ``imu`` table (read in place)."""
+        cols, dt = _imu(imu)
+        self._native.push_imu_block(cols, dt)
+
+    def push_gnss(self, t: float, lat_deg: float, lon_deg: float, h_m: float, std_ned_m: Sequence[float], vel_ned_mps: Optional[Sequence[float]] = None, vel_std_ned_mps: Optional[Sequence[float]] = None) -> None:
+        """One GNSS fix [s, deg, deg, m; std m; velocity m/s]."""
+        self._native.push_gnss(t, lat_deg, lon_deg, h_m, list(std_ned_m), None if vel_ned_mps is None else list(vel_ned_mps), None if vel_std_ned_mps is None else list(vel_std_ned_mps))
+
+    def push_baro(self, t: float, h_m: float) -> None:
+        """One barometric height [m] at ``t`` [s]."""
+        self._native.push_baro(t, h_m)
+
+    def take(self) -> NavResult:
+        """The tables produced since the last ``take``."""
+        return NavResult._of(self._native.take())
+
+    def finish(self) -> NavResult:
+        """Ends the session: the remaining tables, ``smoothed`` and ``summary``."""
+        return NavResult._of(self._native.finish())
+
+
+@dataclass
+class SimResult:
+    """What :func:`simulate` gives, as DataFrames (the data of ``schuler simulate``'s
+    files): ``imu`` (measured samples, :func:`read_imu`'s columns), ``truth`` (the
+    exact trajectory at every IMU sample: :func:`read_nav`'s columns, then the true
+    ``w_*_radps`` and ``f_*_mps2`` in body axes), ``gnss`` (:func:`read_gnss`'s columns
+    and ``outlier``; None without ``[gnss]``), ``baro`` (``t_s``, ``h_m``,
+    ``outlier``; None without ``[baro]``), ``sensor_errors`` (the true biases and
+    scale factors once a second, ``imu_err.txt``'s units) and ``scenario`` (every
+    parameter used, seed included, as TOML)."""
+
+    imu: pd.DataFrame
+    truth: pd.DataFrame
+    gnss: Optional[pd.DataFrame]
+    baro: Optional[pd.DataFrame]
+    sensor_errors: pd.DataFrame
+    scenario: str
+
+
+def simulate(scenario: Union[PathLike, str, Mapping[str, Any]]) -> SimResult:
+    """Simulate a ``schuler simulate`` scenario: a ``.toml`` file, TOML text, or a dict
+    of the same keys (e.g. ``{"seed": 7, "start": {...}, "motion": [...], "imu":
+    {"rate_hz": 200, "preset": "tactical"}, "gnss": {...}}``). The same scenario and
+    seed give the same bits. The GIL is released while it runs."""
+    if isinstance(scenario, Mapping):
+        d = _schuler.simulate_scenario(json.dumps(scenario), "json")
+    elif isinstance(scenario, os.PathLike) or (
+        isinstance(scenario, str) and "\n" not in scenario and scenario.strip().endswith(".toml")
+    ):
+        d = _schuler.simulate_scenario(path=os.fspath(scenario))
+    else:
+        d = _schuler.simulate_scenario(scenario, "toml")
+    opt = lambda k: None if d.get(k) is None else _frame(d[k])  # noqa: E731
+    return SimResult(
+        imu=_frame(d["imu"]),
+        truth=_frame(d["truth"]),
+        gnss=opt("gnss"),
+        baro=opt("baro"),
+        sensor_errors=_frame(d["sensor_errors"]),
+        scenario=d["scenario"],
+    )
+
+
+#: Columns of a navigation table (:func:`read_nav`, ``NavResult.trajectory``).
+NAV_COLUMNS = ("t_s", "lat_deg", "lon_deg", "h_m", "vn_mps", "ve_mps", "vd_mps", "roll_deg", "pitch_deg", "yaw_deg")
+
+
+@dataclass
+class Comparison:
+    """What :func:`compare` gives: ``errors`` per matched epoch (``errors.csv``:
+    position north, east, down and horizontal [m] along the truth's NED axes,
+    velocity [m/s], roll, pitch, yaw [deg], ``interpolated``) and ``summary``
+    (``compare.json``: matched epochs, per quantity RMS, max, 95 %, mean, CEP/CEP95 [m],
+    outage maxima)."""
+
+    errors: pd.DataFrame
+    summary: Dict[str, Any]
+
+
+def _nav_input(x: Union[PathLike, Table]):
+    if isinstance(x, (str, os.PathLike)):
+        return os.fspath(x)
+    return _columns(x, NAV_COLUMNS, "navigation table")
+
+
+def compare(
+    nav: Union[PathLike, Table],
+    truth: Union[PathLike, Table],
+    start: Optional[float] = None,
+    end: Optional[float] = None,
+    outages: Sequence[Sequence[float]] = (),
+) -> Comparison:
+    """Errors of a navigation result against a truth, as ``schuler compare``: both
+    files (KF-GINS text, ``nav.csv``) or tables of :func:`read_nav`'s columns; matched
+    by time (the truth interpolated where its epochs differ) within ``[start, end]``
+    [s]; ``outages`` as ``(from_s, to_s)`` windows for the outage maxima."""
+    d = _schuler.compare(_nav_input(nav), _nav_input(truth), start, end, [tuple(map(float, o)) for o in outages])
+    errors = _frame(d["errors"])
+    errors["interpolated"] = errors["interpolated"].astype(bool)
+    return Comparison(errors=errors, summary=json.loads(d["summary"]))
+
+
+def allan(imu: Union[PathLike, Table], per_decade: float = 10.0, max_tau: Optional[float] = None, **options: Any) -> pd.DataFrame:
+    """Overlapping Allan deviations of a static IMU log's six channels, as ``schuler
+    allan`` computes them: ``per_decade`` cluster times a decade up to ``max_tau`` [s]
+    (default a tenth of the log). ``imu``: a file (read with the IMU input
+    ``options``) or a table as :func:`navigate`'s. Columns ``tau_s``, ``m`` (cluster
+    size), ``gyro_{x,y,z}_radps``, ``accel_{x,y,z}_mps2``."""
+    if isinstance(imu, (str, os.PathLike)):
+        d = _schuler.allan(path=os.fspath(imu), flags=_flags(options), per_decade=per_decade, max_tau=max_tau)
+    else:
+        if options:
+            raise TypeError("reading options apply to files only")
+        cols, dt = _imu(imu)
+        d = _schuler.allan(imu=cols, imu_dt=dt, per_decade=per_decade, max_tau=max_tau)
+    out = _frame(d)
+    out["m"] = out["m"].astype(np.int64)
+    return out

@@ -1,0 +1,125 @@
+//! The `schuler` Python package's native module `schuler._schuler`: a thin layer over
+//! the library's navigation session and the CLI's readers and option parsing. The
+//! Python side (`python/schuler/`) turns keyword arguments into the CLI's flags and
+//! the dicts of numpy arrays returned here into pandas DataFrames.
+
+mod allan;
+mod arrays;
+mod columns;
+mod compare;
+mod errors;
+mod options;
+mod readers;
+mod run;
+mod session;
+mod simulate;
+
+use arrays::ImuArrays;
+use errors::IntoPy;
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use run::{AnySession, Plan, Tables};
+use schuler_cli::aided::GivenReadings;
+
+/// Views of IMU columns `t, dtheta_x..z, dvel_x..z` and an optional `dt`.
+pub(crate) fn imu_views<'a>(
+    cols: &'a [PyReadonlyArray1<'_, f64>],
+    dt: Option<&'a PyReadonlyArray1<'_, f64>>,
+    t_before: Option<f64>,
+) -> anyhow::Result<ImuArrays<'a>> {
+    let [t, a, b, c, d, e, f] = cols else {
+        anyhow::bail!(
+            "IMU arrays: 7 columns t, dtheta_x..z, dvel_x..z, got {}",
+            cols.len()
+        );
+    };
+    Ok(ImuArrays {
+        t: t.as_array(),
+        dt: dt.map(|d| d.as_array()),
+        inc: [a, b, c, d, e, f].map(|x| x.as_array()),
+        t_before,
+    })
+}
+
+/// The aiding readings given as arrays.
+pub(crate) fn given_readings(
+    gnss: Option<Vec<PyReadonlyArray1<'_, f64>>>,
+    baro: Option<(PyReadonlyArray1<'_, f64>, PyReadonlyArray1<'_, f64>)>,
+) -> anyhow::Result<GivenReadings> {
+    let fixes = match gnss {
+        Some(g) => Some(arrays::gnss_fixes(
+            &g.iter().map(|c| c.as_array()).collect::<Vec<_>>(),
+        )?),
+        None => None,
+    };
+    let baro = match baro {
+        Some((t, h)) => Some(arrays::baro_readings(t.as_array(), h.as_array())?),
+        None => None,
+    };
+    Ok(GivenReadings { fixes, baro })
+}
+
+/// Navigates as `schuler nav` with `flags`: the IMU samples from `imu` (columns) or the
+/// file of `--imu`, aids from `gnss`/`baro` columns or their files. Returns the tables
+/// (see [`Tables::take_dict`]), `smoothed` (with `--smooth`) and `summary`. The GIL is
+/// released while it runs.
+#[pyfunction]
+#[pyo3(signature = (flags, imu=None, imu_dt=None, gnss=None, baro=None))]
+fn navigate<'py>(
+    py: Python<'py>,
+    flags: Vec<String>,
+    imu: Option<Vec<PyReadonlyArray1<'py, f64>>>,
+    imu_dt: Option<PyReadonlyArray1<'py, f64>>,
+    gnss: Option<Vec<PyReadonlyArray1<'py, f64>>>,
+    baro: Option<(PyReadonlyArray1<'py, f64>, PyReadonlyArray1<'py, f64>)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let plan = given_readings(gnss, baro)
+        .and_then(|given| Plan::new(&flags, given))
+        .py_err(py)?;
+    let views = match &imu {
+        Some(cols) => Some(imu_views(cols, imu_dt.as_ref(), None).py_err(py)?),
+        None => None,
+    };
+    let mut tables = Tables::default();
+    let finished = py
+        .detach(|| -> anyhow::Result<_> {
+            let mut session = AnySession::open(&plan)?;
+            let (s, t) = (&plan.settings, &mut tables);
+            let n = match &views {
+                Some(v) => run::drive(&mut session, t, v.samples(s.read.t_start, s.read.t_end)?)?,
+                None => {
+                    let reader = schuler_cli::formats::ImuReader::open(&s.imu, &s.read)?;
+                    run::drive(&mut session, t, reader)?
+                }
+            };
+            if n == 0 {
+                anyhow::bail!(
+                    "{}: no IMU sample in the requested time window",
+                    s.imu.display()
+                );
+            }
+            session.finish(t)
+        })
+        .py_err(py)?;
+    let d = tables.take_dict(py)?;
+    session::add_finished(py, &d, &finished)?;
+    Ok(d)
+}
+
+/// The native module.
+#[pymodule]
+fn _schuler(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(navigate, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::read_imu, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::read_gnss, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::read_baro, m)?)?;
+    m.add_function(wrap_pyfunction!(readers::read_nav, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(allan::allan, m)?)?;
+    m.add_class::<session::PySession>()?;
+    m.add("SchulerError", m.py().get_type::<errors::SchulerError>())?;
+    m.add("InputError", m.py().get_type::<errors::InputError>())?;
+    Ok(())
+}

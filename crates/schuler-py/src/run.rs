@@ -1,0 +1,309 @@
+//! A navigation run as the CLI's `nav` sets it up ([`schuler_cli::commands::nav`]):
+//! the options parsed and checked, the aiding resolved, the library's
+//! [`schuler::session::Session`] opened on the chosen Earth model; what comes out is
+//! collected into tables instead of files, with the CLI's conversions, so the numbers
+//! are those `nav.txt`, `std.txt`, `imu_err.txt`, `innovations.csv` and
+//! `rejected.csv` print.
+
+use crate::columns::{Columns, INNOVATIONS, NAV, SENSOR, STD};
+use anyhow::{Result, bail};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use schuler::earth::{Sphere, Wgs84};
+use schuler::filter::smoother::Smoothed;
+use schuler::imu::ImuSample;
+use schuler::session::{Epoch, Event, Finished, Session};
+use schuler_cli::aided::record::InnovationRow;
+use schuler_cli::aided::{Aiding, GivenReadings};
+use schuler_cli::commands::nav::{InitChoice, parse_nav_args, resolve_aiding};
+use schuler_cli::drive::{Refusal, imu_err_row, std_row};
+use schuler_cli::navigate::{NavSettings, open_session};
+use schuler_cli::options::EarthChoice;
+use schuler_cli::output::nav_fields;
+
+/// The settings and aiding of a run, from the CLI's flags.
+pub struct Plan {
+    /// Settings (the IMU path among them, unused for arrays).
+    pub settings: NavSettings,
+    /// The filter and the aids, if any aiding is given.
+    pub aiding: Option<Aiding>,
+}
+
+impl Plan {
+    /// The plan of `flags` with `given` readings in place of `--gnss`/`--baro` files.
+    pub fn new(flags: &[String], given: GivenReadings) -> Result<Self> {
+        let plan = parse_nav_args(crate::options::nav_args(flags)?)?;
+        if plan.align || plan.init != InitChoice::Given {
+            bail!(
+                "align and init=\"gnss\" are not available from Python yet: give init_att \
+                 (and init_vel), or run `schuler nav --align` / `--init gnss`"
+            );
+        }
+        let aiding = resolve_aiding(&plan.alignment, &plan.aiding, given)?;
+        Ok(Self {
+            settings: plan.settings,
+            aiding,
+        })
+    }
+}
+
+/// A session on the Earth model the options chose.
+pub enum AnySession {
+    /// WGS84.
+    Wgs84(Session<Wgs84>),
+    /// The textbook sphere, rotating or not.
+    Sphere(Session<Sphere>),
+}
+
+/// `$body` with `$s` bound to the session whatever its Earth model.
+macro_rules! each {
+    ($session:expr, $s:ident => $body:expr) => {
+        match $session {
+            AnySession::Wgs84($s) => $body,
+            AnySession::Sphere($s) => $body,
+        }
+    };
+}
+
+impl AnySession {
+    /// The session of `plan`, aids pushed, starting at the first sample.
+    pub fn open(plan: &Plan) -> Result<Self> {
+        let (s, a) = (&plan.settings, plan.aiding.as_ref());
+        Ok(match s.earth {
+            EarthChoice::Wgs84 => Self::Wgs84(open_session(Wgs84, s, a, s.start())?),
+            EarthChoice::Sphere => {
+                Self::Sphere(open_session(Sphere::textbook(true), s, a, s.start())?)
+            }
+            EarthChoice::SphereFixed => {
+                Self::Sphere(open_session(Sphere::textbook(false), s, a, s.start())?)
+            }
+        })
+    }
+
+    /// Pushes one IMU sample.
+    pub fn push_imu(&mut self, s: ImuSample) -> Result<()> {
+        Ok(each!(self, x => x.push_imu(s))?)
+    }
+
+    /// Pushes one aid.
+    pub fn push(&mut self, aid: schuler::session::Aid) -> Result<()> {
+        Ok(each!(self, x => x.push(aid))?)
+    }
+
+    /// Moves the epochs and events so far into `tables`.
+    pub fn take(&mut self, tables: &mut Tables) {
+        each!(self, x => {
+            for e in x.epochs() {
+                tables.epoch(&e);
+            }
+            for e in x.events() {
+                tables.event(e);
+            }
+        })
+    }
+
+    /// Ends the input and the session; the epochs and events it still held go to
+    /// `tables`.
+    pub fn finish(mut self, tables: &mut Tables) -> Result<Finished> {
+        each!(&mut self, x => x.end_of_input());
+        self.take(tables);
+        Ok(each!(self, x => x.finish())?)
+    }
+}
+
+/// What a run gives, table by table.
+pub struct Tables {
+    /// The navigation result at the output epochs.
+    pub trajectory: Columns,
+    /// The filter's standard deviations at the output epochs.
+    pub std: Columns,
+    /// The filter's sensor-error estimates at the output epochs.
+    pub sensor_errors: Columns,
+    /// Every tested measurement (numbers).
+    pub innovations: Columns,
+    /// The measurement kind of each innovation.
+    pub innovation_kinds: Vec<String>,
+    /// Measurements not used, with why.
+    pub refused: Vec<Refusal>,
+    /// Warnings (the solution leaving the physical envelope).
+    pub warnings: Vec<String>,
+}
+
+impl Default for Tables {
+    fn default() -> Self {
+        Self {
+            trajectory: Columns::new(NAV),
+            std: Columns::new(STD),
+            sensor_errors: Columns::new(SENSOR),
+            innovations: Columns::new(INNOVATIONS),
+            innovation_kinds: Vec::new(),
+            refused: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+}
+
+impl Tables {
+    /// One output epoch, in `nav.txt`'s, `std.txt`'s and `imu_err.txt`'s units.
+    fn epoch(&mut self, e: &Epoch) {
+        let t = e.state.t;
+        self.trajectory.push(t, &nav_fields(&e.state));
+        if let Some(f) = &e.filter {
+            self.std.push(t, &std_row(f));
+            self.sensor_errors.push(t, &imu_err_row(&f.estimates));
+        }
+    }
+
+    /// One event: an innovation, a refusal, or a warning.
+    fn event(&mut self, e: Event) {
+        if let Event::Envelope { t, what } = &e {
+            self.warnings.push(format!(
+                "at t = {t} s the solution left the physical envelope: {what}"
+            ));
+        }
+        if let Event::Measurement(i) = &e {
+            if let Ok(r) = InnovationRow::of(i) {
+                let unused = |k: usize, x: f64| if k < r.dof { x } else { f64::NAN };
+                let z: Vec<f64> = (0..3).map(|k| unused(k, r.z[k])).collect();
+                let s: Vec<f64> = (0..3).map(|k| unused(k, r.sigma[k])).collect();
+                let head = [f64::from(u8::from(r.accepted)), r.dof as f64, r.nis];
+                self.innovations.push(r.t, &[&head[..], &z, &s].concat());
+                self.innovation_kinds.push(r.kind.to_string());
+            }
+            return;
+        }
+        if let Some(r) = Refusal::of(&e) {
+            self.refused.push(r);
+        }
+    }
+
+    /// The tables so far as a dict of dicts of numpy arrays (`trajectory`, `std`,
+    /// `sensor_errors`, `innovations` with `kind`, `refused`, `warnings`), leaving them
+    /// empty.
+    pub fn take_dict<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("trajectory", self.trajectory.take_dict(py)?)?;
+        d.set_item("std", self.std.take_dict(py)?)?;
+        d.set_item("sensor_errors", self.sensor_errors.take_dict(py)?)?;
+        let inn = self.innovations.take_dict(py)?;
+        inn.set_item("kind", std::mem::take(&mut self.innovation_kinds))?;
+        d.set_item("innovations", inn)?;
+        let mut refused = std::mem::take(&mut self.refused);
+        refused.sort_by(|a, b| a.t.total_cmp(&b.t));
+        let r = PyDict::new(py);
+        let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        r.set_item("t_s", refused.iter().map(|x| x.t).collect::<Vec<_>>())?;
+        r.set_item(
+            "measurement",
+            refused
+                .iter()
+                .map(|x| x.measurement.clone())
+                .collect::<Vec<_>>(),
+        )?;
+        r.set_item(
+            "reason",
+            refused.iter().map(|x| x.reason.clone()).collect::<Vec<_>>(),
+        )?;
+        r.set_item(
+            "nis",
+            refused.iter().map(|x| nan(x.nis)).collect::<Vec<_>>(),
+        )?;
+        r.set_item(
+            "threshold",
+            refused.iter().map(|x| nan(x.threshold)).collect::<Vec<_>>(),
+        )?;
+        d.set_item("refused", r)?;
+        d.set_item("warnings", std::mem::take(&mut self.warnings))?;
+        Ok(d)
+    }
+}
+
+/// Pushes `samples` into `session`, collecting what comes out into `tables` after
+/// each; returns the count pushed. A read error or a refused sample stops the run.
+pub fn drive(
+    session: &mut AnySession,
+    tables: &mut Tables,
+    samples: impl Iterator<Item = Result<ImuSample, schuler_cli::formats::InputError>>,
+) -> Result<u64> {
+    let mut n = 0;
+    for s in samples {
+        session.push_imu(s?)?;
+        session.take(tables);
+        n += 1;
+    }
+    Ok(n)
+}
+
+/// The smoothed trajectory: `nav.txt`'s columns, then the position, velocity and
+/// attitude standard deviations of `std.txt`.
+pub fn smoothed_columns(smoothed: &[Smoothed]) -> Columns {
+    let mut c = Columns::new(SMOOTHED);
+    for s in smoothed {
+        let mut row = nav_fields(&s.state).to_vec();
+        row.extend(s.std[0].iter().chain(s.std[1].iter()));
+        row.extend(s.std[2].iter().map(|x| x.to_degrees()));
+        c.push(s.state.t, &row);
+    }
+    c
+}
+
+/// Columns of the smoothed trajectory.
+const SMOOTHED: &[&str] = &[
+    "t_s",
+    "lat_deg",
+    "lon_deg",
+    "h_m",
+    "vn_mps",
+    "ve_mps",
+    "vd_mps",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "std_n_m",
+    "std_e_m",
+    "std_d_m",
+    "std_vn_mps",
+    "std_ve_mps",
+    "std_vd_mps",
+    "std_roll_deg",
+    "std_pitch_deg",
+    "std_yaw_deg",
+];
+
+/// The session's summary as a dict: samples, time span, measurement counts, mean NIS
+/// per degree of freedom, hand-overs.
+pub fn summary_dict<'py>(py: Python<'py>, f: &Finished) -> PyResult<Bound<'py, PyDict>> {
+    let s = &f.summary;
+    let d = PyDict::new(py);
+    d.set_item("samples", s.samples)?;
+    d.set_item("t_first_s", s.t_first)?;
+    d.set_item("t_last_s", s.t_last)?;
+    d.set_item("first_mechanization", s.first_mechanization.to_string())?;
+    let c = &s.counts;
+    let counts = PyDict::new(py);
+    for (k, v) in [
+        ("gnss_position", c.position),
+        ("gnss_velocity", c.velocity),
+        ("baro_height", c.baro),
+        ("zero_velocity", c.zupt),
+        ("zero_rate", c.zaru),
+        ("non_holonomic", c.nhc),
+        ("odometer", c.odometer),
+        ("heading", c.heading),
+        ("rejected", c.rejected),
+        ("skipped", c.skipped),
+    ] {
+        counts.set_item(k, v)?;
+    }
+    d.set_item("counts", counts)?;
+    d.set_item("late", s.late)?;
+    d.set_item("gate_resets", s.gate_resets)?;
+    d.set_item("mean_nis_per_dof", s.mean_nis_per_dof)?;
+    let h: Vec<(f64, f64, String)> = s
+        .handovers
+        .iter()
+        .map(|h| (h.t, h.lat.to_degrees(), h.to.to_string()))
+        .collect();
+    d.set_item("handovers", h)?;
+    Ok(d)
+}
