@@ -670,3 +670,66 @@ fn bad_aiding_options_name_the_flag_and_results_survive_a_late_error() {
     let rows = common::read_rows(&dir.path().join("out/nav.txt"));
     assert!(rows.len() >= 29_900, "{} rows kept", rows.len());
 }
+
+/// `--gravity kf-gins` against the default TR8350.2 on the error-free drive, free
+/// inertial: the two differ only in gravity, by `δg` (1.4e-6 m/s² here), and the
+/// vertical channel answers a constant acceleration error with the closed form
+/// `δh(t) = −δg (cosh(ω t) − 1) / ω²`, `ω² = 2 g / R` (the unstable vertical channel;
+/// Titterton & Weston ch. 3). The drive's climb (245–290 m) changes `δg` by under
+/// 0.5 % (the two height terms differ by about 1e-10 m/s² per metre) and its 8 km of
+/// latitude by less, and the horizontal channels feed back nothing at this order:
+/// within 1 % after 529 s (measured: ratio 1.0000).
+#[test]
+fn kf_gins_gravity_moves_the_vertical_channel_as_the_closed_form() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = unpack(dir.path(), "IMU_true.txt");
+    let last_height = |gravity: &str| {
+        let out = dir.path().join(gravity);
+        assert_cmd::Command::cargo_bin("schuler")
+            .expect("binary")
+            .args(["nav", "--imu"])
+            .arg(&imu)
+            .args(["--init-pos", "45.0712345678,7.6812345678,245"])
+            .args([
+                "--init-att",
+                "0,0,10",
+                "--start",
+                "1.0",
+                "--output-rate",
+                "1",
+            ])
+            .args(["--mechanization", "ned", "--gravity", gravity, "--out"])
+            .arg(&out)
+            .assert()
+            .success();
+        let rows = common::read_rows(&out.join("nav.txt"));
+        let last = rows.last().expect("rows");
+        (last[1], last[4])
+    };
+    let (t_end, h_kf) = last_height("kf-gins");
+    let (_, h_tr) = last_height("tr8350");
+    let lat = 45.0712345678f64.to_radians();
+    let dg =
+        schuler::earth::Wgs84Series::normal_gravity(lat, 245.0) - Wgs84::normal_gravity(lat, 245.0);
+    let r = Wgs84::A;
+    let w = (2.0 * Wgs84::normal_gravity(lat, 245.0) / r).sqrt();
+    let t = t_end - 1.0;
+    let expected = -dg * ((w * t).cosh() - 1.0) / (w * w);
+    let ratio = (h_kf - h_tr) / expected;
+    eprintln!(
+        "dg {dg:e} m/s^2: height difference {:.4} m, closed form {expected:.4} m, ratio {ratio:.4}",
+        h_kf - h_tr
+    );
+    assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
+    // The sphere has its own gravity.
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--imu"])
+        .arg(&imu)
+        .args(["--init-pos", "45,7,245", "--init-att", "0,0,10"])
+        .args(["--earth", "sphere", "--gravity", "kf-gins", "--out"])
+        .arg(dir.path().join("sphere"))
+        .assert()
+        .failure()
+        .stderr(predicates::str::contains("--gravity"));
+}
