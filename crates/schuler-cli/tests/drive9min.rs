@@ -733,3 +733,40 @@ fn kf_gins_gravity_moves_the_vertical_channel_as_the_closed_form() {
         .failure()
         .stderr(predicates::str::contains("--gravity"));
 }
+
+/// A write that fails on the writer thread (the disk full: `nav.txt` is `/dev/full`)
+/// stops the run with an error naming the file, neither hanging nor panicking, both
+/// mid-run (52,900 rows) and at the last flush (100 rows).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_failed_write_on_the_writer_thread_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = unpack(dir.path(), "IMU.txt");
+    for (name, end) in [("all", "530"), ("short", "2")] {
+        let out = dir.path().join(name);
+        std::fs::create_dir_all(&out).expect("out");
+        std::os::unix::fs::symlink("/dev/full", out.join("nav.txt")).expect("symlink");
+        assert_cmd::Command::cargo_bin("schuler")
+            .expect("binary")
+            .args(["nav", "--imu"])
+            .arg(&imu)
+            .args(["--init-pos", "45.0712345678,7.6812345678,245"])
+            .args([
+                "--init-att",
+                "0,0,10",
+                "--start",
+                "1.0",
+                "--end",
+                end,
+                "--out",
+            ])
+            .arg(&out)
+            .timeout(std::time::Duration::from_secs(60))
+            .assert()
+            .failure()
+            .stderr(
+                predicates::str::contains("cannot write").and(predicates::str::contains("nav.txt")),
+            )
+            .stderr(predicates::str::contains("panicked").not());
+    }
+}
