@@ -7,7 +7,7 @@ use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, AlignError, Alignment, HeadingSource, MotionReport, align};
-use schuler::earth::{Geodetic, Sphere, Wgs84};
+use schuler::earth::{Geodetic, Sphere, Wgs84, Wgs84Series};
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
@@ -140,6 +140,7 @@ pub fn align_on(
 ) -> Result<Alignment> {
     let r = match earth {
         EarthChoice::Wgs84 => align(Wgs84, pos, samples, noise, cfg),
+        EarthChoice::Wgs84Series => align(Wgs84Series, pos, samples, noise, cfg),
         EarthChoice::Sphere | EarthChoice::SphereFixed => align(
             Sphere::textbook(earth == EarthChoice::Sphere),
             pos,

@@ -8,7 +8,10 @@
 
 use crate::aided::record::InnovationLog;
 use crate::bag::output::ResultBag;
+use crate::fixed::{Words, put_field};
 use crate::output::{NavEpoch, NavWriter, push_fixed};
+use crate::text_block::{TextBlock, put_first_field};
+use crate::writer_thread::WriterThread;
 use anyhow::{Context, Result};
 use schuler::earth::EarthModel;
 use schuler::filter::SensorEstimates;
@@ -18,42 +21,74 @@ use schuler::imu::ImuSample;
 use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session};
 use schuler::units::{DEG_PER_H, MGAL, PPM};
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Text writer for `std.txt` and `imu_err.txt`.
+/// Text writer for `std.txt` and `imu_err.txt`, through the fast row writer
+/// ([`TextBlock`]).
 pub struct Table {
-    w: BufWriter<File>,
+    file: File,
     path: PathBuf,
+    text: TextBlock,
     line: Vec<u8>,
 }
+
+/// A table line's window: the time and up to [`TABLE_FAST_VALUES`] values of at most
+/// 17 bytes with their separators, and the newline, fit in 512 bytes.
+const TABLE_WINDOW: usize = 512 + 8;
+/// Most values a line through the window holds.
+const TABLE_FAST_VALUES: usize = 26;
+/// Text gathered before it goes to the file [bytes].
+const TABLE_BLOCK: usize = 1 << 16;
 
 impl Table {
     /// Creates `dir/name`.
     pub fn create(dir: &Path, name: &str) -> Result<Self> {
         let path = dir.join(name);
-        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+        let file =
+            File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
         Ok(Self {
-            w: BufWriter::with_capacity(1 << 16, f),
+            file,
             path,
+            text: TextBlock::default(),
             line: Vec::with_capacity(512),
         })
     }
 
-    /// One row: time, then the values.
+    /// One row: time, then the values (the bytes of [`push_table_row`]).
     pub fn row(&mut self, t: f64, values: &[f64]) -> Result<()> {
-        self.line.clear();
-        push_table_row(&mut self.line, t, values);
-        self.w
-            .write_all(&self.line)
-            .with_context(|| format!("cannot write {}", self.path.display()))
+        let stored = values.len() <= TABLE_FAST_VALUES
+            && self.text.put_line::<TABLE_WINDOW>(b' ', |w| {
+                let mut pos = put_first_field(w, 0, t, 6)?;
+                for v in values {
+                    pos = put_field(w, pos, *v, 9)?;
+                }
+                w.put(pos, u64::from(b'\n'));
+                Some(pos + 1)
+            });
+        if !stored {
+            self.line.clear();
+            push_table_row(&mut self.line, t, values);
+            self.text.extend(&self.line);
+        }
+        if self.text.len() >= TABLE_BLOCK {
+            self.flush()?;
+        }
+        Ok(())
     }
 
-    /// Flushes the file.
+    /// Writes the gathered text to the file.
+    fn flush(&mut self) -> Result<()> {
+        self.file
+            .write_all(self.text.as_bytes())
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        self.text.clear();
+        Ok(())
+    }
+
+    /// Writes what is left to the file.
     pub fn finish(mut self) -> Result<()> {
-        self.w
-            .flush()
-            .with_context(|| format!("cannot write {}", self.path.display()))
+        self.flush()
     }
 }
 
@@ -179,28 +214,36 @@ impl Refusal {
 pub struct FilterFiles {
     std: Table,
     err: Table,
-    /// Every tested measurement (`innovations.csv`), kept for the report.
-    pub innovations: InnovationLog,
+    /// Every tested measurement (`innovations.csv`), kept for the report; `None`
+    /// without the diagnostics.
+    pub innovations: Option<InnovationLog>,
     /// `rejected.csv`'s rows with their times, in event order.
     refused: Vec<(f64, String)>,
 }
 
 impl FilterFiles {
-    /// Creates `std_name`, `err_name` and `innovations.csv` in `dir`.
-    pub fn create(dir: &Path, std_name: &str, err_name: &str) -> Result<Self> {
+    /// Creates `std_name`, `err_name` and, with the diagnostics, `innovations.csv`
+    /// in `dir`.
+    pub fn create(dir: &Path, std_name: &str, err_name: &str, diagnostics: bool) -> Result<Self> {
         Ok(Self {
             std: Table::create(dir, std_name)?,
             err: Table::create(dir, err_name)?,
-            innovations: InnovationLog::create(dir)?,
+            innovations: diagnostics
+                .then(|| InnovationLog::create(dir))
+                .transpose()?,
             refused: Vec::new(),
         })
     }
 
-    /// Flushes the tables and writes `dir/rejected.csv` (rows sorted by time).
-    pub fn finish(mut self, dir: &Path) -> Result<InnovationLog> {
+    /// Flushes the tables and, with the diagnostics, writes `dir/rejected.csv` (rows
+    /// sorted by time); returns the innovations (with the diagnostics).
+    pub fn finish(mut self, dir: &Path) -> Result<Option<InnovationLog>> {
         self.std.finish()?;
         self.err.finish()?;
-        self.innovations.finish()?;
+        let Some(mut innovations) = self.innovations else {
+            return Ok(None);
+        };
+        innovations.finish()?;
         let mut s = String::from("t,measurement,reason,nis,threshold\n");
         self.refused.sort_by(|a, b| a.0.total_cmp(&b.0));
         for (_, r) in &self.refused {
@@ -208,7 +251,7 @@ impl FilterFiles {
         }
         let path = dir.join("rejected.csv");
         std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(self.innovations)
+        Ok(Some(innovations))
     }
 }
 
@@ -224,6 +267,8 @@ pub struct Outputs {
     /// The first epoch whose heading standard deviation fell below 1°: its time and
     /// heading [rad].
     heading_settled: Option<(f64, f64)>,
+    /// Whether the next epoch (the start) is left out, as KF-GINS does.
+    skip_start: bool,
 }
 
 impl Outputs {
@@ -235,10 +280,24 @@ impl Outputs {
             bag: None,
             last_written: f64::NAN,
             heading_settled: None,
+            skip_start: false,
         }
     }
 
-    fn epoch(&mut self, e: &Epoch) -> Result<()> {
+    /// The same outputs from the epoch after the start (KF-GINS's first row is the
+    /// state one sample after its start).
+    pub fn without_start_epoch(self) -> Self {
+        Self {
+            skip_start: true,
+            ..self
+        }
+    }
+
+    /// Writes one output epoch.
+    pub fn write_epoch(&mut self, e: &Epoch) -> Result<()> {
+        if std::mem::take(&mut self.skip_start) {
+            return Ok(());
+        }
         self.nav.write_epoch(&NavEpoch {
             state: e.state,
             r_e: e.r_e,
@@ -261,6 +320,18 @@ impl Outputs {
         Ok(())
     }
 
+    /// Writes the state where a failed input stopped the run, unless it was the last
+    /// epoch written or is not finite.
+    pub fn write_last(&mut self, e: &Epoch) -> Result<()> {
+        if e.state.t != self.last_written
+            && e.state.pos.lat.is_finite()
+            && e.state.v_n.iter().all(|x| x.is_finite())
+        {
+            self.write_epoch(e)?;
+        }
+        Ok(())
+    }
+
     /// Writes one event (an envelope warning to stderr, the filter's records to
     /// `innovations.csv` and `rejected.csv`).
     pub fn event(&mut self, e: Event) -> Result<()> {
@@ -275,7 +346,7 @@ impl Outputs {
             return Ok(());
         };
         if let Event::Measurement(i) = &e {
-            return files.innovations.push(i);
+            return files.innovations.as_mut().map_or(Ok(()), |log| log.push(i));
         }
         let Some(r) = Refusal::of(&e) else {
             return Ok(());
@@ -288,7 +359,7 @@ impl Outputs {
     /// Writes the session's epochs and events so far.
     pub fn take<E: EarthModel>(&mut self, session: &mut Session<E>) -> Result<()> {
         for e in session.epochs() {
-            self.epoch(&e)?;
+            self.write_epoch(&e)?;
         }
         for e in session.events() {
             self.event(e)?;
@@ -313,15 +384,23 @@ pub struct Driven {
     pub heading_settled: Option<(f64, f64)>,
 }
 
-/// Pushes `samples` into `session`, writing what comes out to `out`; `on_sample` is
-/// called every 65,536 samples with their count. On a read error the session ends
-/// there, its last state is written (if it was not an output epoch) and the error is
-/// returned in [`Driven::failure`] with the count and the time reached. `None` when
-/// the input held no sample at all.
+/// The writer thread's own error, after a hand-over to it failed.
+fn writer_error(pipe: WriterThread) -> anyhow::Error {
+    match pipe.join() {
+        Err(e) => e,
+        Ok(_) => anyhow::anyhow!("the writer thread stopped"),
+    }
+}
+
+/// Pushes `samples` into `session`, writing what comes out to `out` on a writer
+/// thread ([`WriterThread`]); `on_sample` is called every 65,536 samples with their
+/// count. On a read error the session ends there, its last state is written (if it
+/// was not an output epoch) and the error is returned in [`Driven::failure`] with the
+/// count and the time reached. `None` when the input held no sample at all.
 pub fn drive<M: EarthModel, I, E>(
     mut session: Session<M>,
     samples: I,
-    mut out: Outputs,
+    out: Outputs,
     dir: &Path,
     mut on_sample: impl FnMut(u64),
 ) -> Result<Option<Driven>>
@@ -329,6 +408,7 @@ where
     I: Iterator<Item = Result<ImuSample, E>>,
     E: std::error::Error + Send + Sync + 'static,
 {
+    let mut pipe = WriterThread::spawn(out)?;
     let mut n = 0u64;
     let mut failure: Option<anyhow::Error> = None;
     for s in samples {
@@ -339,26 +419,30 @@ where
             failure = Some(e);
             break;
         }
-        out.take(&mut session)?;
+        if pipe.take(&mut session).is_err() {
+            return Err(writer_error(pipe));
+        }
         n += 1;
         if n.is_multiple_of(65_536) {
             on_sample(n);
         }
     }
     session.end_of_input();
-    out.take(&mut session)?;
+    if pipe.take(&mut session).is_err() {
+        return Err(writer_error(pipe));
+    }
     if n == 0 && session.integrated_to().is_none() {
         // Nothing was pushed: the session has no state to report.
+        pipe.join()?;
         return failure.map_or(Ok(None), Err);
     }
     if failure.is_some()
         && let Some(e) = session.epoch_now()
-        && e.state.t != out.last_written
-        && e.state.pos.lat.is_finite()
-        && e.state.v_n.iter().all(|x| x.is_finite())
+        && pipe.last(e).is_err()
     {
-        out.epoch(&e)?;
+        return Err(writer_error(pipe));
     }
+    let out = pipe.join()?;
     let finished = match session.finish() {
         Ok(f) => f,
         Err(e) => {

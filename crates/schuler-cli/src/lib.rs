@@ -15,3 +15,5 @@ pub mod options;
 pub mod output;
 pub mod plot;
 pub mod report;
+pub mod text_block;
+pub mod writer_thread;

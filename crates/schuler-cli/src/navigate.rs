@@ -3,8 +3,8 @@
 //! its output written by [`crate::drive`]. With aiding the run also writes
 //! `rejected.csv`, the smoothed trajectory on request and the consistency report.
 
-use crate::aided::Aiding;
 use crate::aided::report::{ReportData, RunFacts};
+use crate::aided::{Aiding, OutputNames};
 use crate::drive::{Driven, FilterFiles, Outputs, drive, write_smoothed};
 use crate::formats::ImuReadOptions;
 use crate::options::EarthChoice;
@@ -60,13 +60,23 @@ impl NavSettings {
         ))
     }
 
-    /// The session's configuration, with the filter of `aiding` if any.
+    /// The session's configuration, with the filter of `aiding` if any; the
+    /// filter's snapshots only where the report uses them (its HTML or a truth's
+    /// NEES), so that a run without keeps nothing per epoch.
     pub fn session_config(&self, aiding: Option<&Aiding>) -> SessionConfig {
+        let defaults = SessionConfig::default();
+        let snapshots = aiding
+            .is_some_and(|a| a.names.diagnostics && (a.report.html || a.report.truth.is_some()));
         SessionConfig {
             mechanization: self.mechanization,
             output_rate: self.output_rate,
             filter: aiding.map(|a| a.filter),
-            ..SessionConfig::default()
+            snapshot_rate: if snapshots {
+                defaults.snapshot_rate
+            } else {
+                0.0
+            },
+            ..defaults
         }
     }
 }
@@ -124,13 +134,21 @@ fn outputs<E: EarthModel>(
     aiding: Option<&Aiding>,
 ) -> Result<Outputs> {
     let out = &settings.out;
-    let nav_name = aiding.map_or("nav.txt", |a| a.names.nav);
-    let writer = NavWriter::create_named(out, nav_name, settings.week, earth)?;
+    let names = aiding.map_or(OutputNames::SCHULER, |a| a.names);
+    let writer = NavWriter::create_named(out, names.nav, settings.week, earth, names.nav_csv)?;
     let files = match aiding {
-        Some(a) => Some(FilterFiles::create(out, a.names.std, a.names.imu_err)?),
+        Some(a) => Some(FilterFiles::create(
+            out,
+            a.names.std,
+            a.names.imu_err,
+            names.diagnostics,
+        )?),
         None => None,
     };
     let mut outputs = Outputs::new(writer, files);
+    if !names.start_epoch {
+        outputs = outputs.without_start_epoch();
+    }
     if let Some(path) = &settings.out_bag {
         outputs.bag = Some(crate::bag::output::ResultBag::create(path)?);
     }
@@ -177,6 +195,9 @@ fn finish_aided<E: EarthModel>(
     if let Some(e) = failure {
         return Err(e);
     }
+    let Some(log) = log else {
+        return Ok(String::new());
+    };
     let nav_file = out.join(a.names.nav);
     crate::aided::report::write(
         out,

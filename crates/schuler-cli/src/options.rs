@@ -47,6 +47,39 @@ pub enum EarthChoice {
     Sphere,
     /// The textbook's sphere without rotation.
     SphereFixed,
+    /// WGS84 ellipsoid with the GRS80 normal gravity series KF-GINS uses
+    /// ([`schuler::earth::Wgs84Series`]); chosen by `--gravity kf-gins`.
+    #[value(skip)]
+    #[serde(skip)]
+    Wgs84Series,
+}
+
+impl EarthChoice {
+    /// The model with normal gravity `gravity` (only WGS84 has a choice; `None`
+    /// keeps the model's own).
+    pub fn with_gravity(self, gravity: Option<GravityChoice>) -> Result<Self, String> {
+        match (self, gravity) {
+            (_, None) => Ok(self),
+            (Self::Wgs84 | Self::Wgs84Series, Some(GravityChoice::Tr8350)) => Ok(Self::Wgs84),
+            (Self::Wgs84 | Self::Wgs84Series, Some(GravityChoice::KfGins)) => Ok(Self::Wgs84Series),
+            (Self::Sphere | Self::SphereFixed, Some(_)) => Err(
+                "--gravity chooses the normal gravity of --earth wgs84; the sphere has its own"
+                    .to_owned(),
+            ),
+        }
+    }
+}
+
+/// Normal gravity on the WGS84 ellipsoid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GravityChoice {
+    /// NIMA TR8350.2's closed form (Somigliana with its height series): the default
+    /// of `schuler nav`.
+    Tr8350,
+    /// The GRS80 series in sin^2(lat) with a second-order height term, as KF-GINS
+    /// computes it: the default of `--kf-gins-config`.
+    KfGins,
 }
 
 /// The IMU log's file format.

@@ -26,7 +26,8 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 pub use crate::fixed::push_fixed;
-use crate::fixed::{Words, put_bytes, put_field};
+use crate::fixed::{Line, Twin, Words, put_bytes, put_field};
+use crate::text_block::{TextBlock, put_first_field, window};
 use std::f64::consts::FRAC_PI_2;
 
 /// Longitude (or any angle) [rad] in degrees, wrapped to (-180, 180]
@@ -222,18 +223,30 @@ fn ecef_of(p: &Geodetic, a: f64, e2: f64) -> Vector3<f64> {
     )
 }
 
-/// Writes `nav.txt` (KF-GINS) and `nav.csv` side by side.
+/// Writes `nav.txt` (KF-GINS) and `nav.csv` side by side (or the text alone),
+/// through the fast row writer ([`TextBlock`]).
 pub struct NavWriter {
-    txt: BufWriter<File>,
-    csv: BufWriter<File>,
+    txt: File,
+    /// `nav.csv` and its path, unless the text is written alone.
+    csv: Option<(File, PathBuf)>,
     txt_path: PathBuf,
-    csv_path: PathBuf,
-    week: u32,
+    /// `week` and a space: the start of every `nav.txt` line.
+    week: Vec<u8>,
+    txt_text: TextBlock,
+    csv_text: TextBlock,
     line: Vec<u8>,
     rows: u64,
     /// Ellipsoid `(a, e²)` when the CSV has the ECEF and wander-azimuth columns.
     extended: Option<(f64, f64)>,
 }
+
+/// Windows of a `nav.txt` line after its week (the time and 9 fields of at most 17
+/// bytes with their separators, 188 bytes) and of a `nav.csv` line (14 such fields:
+/// 273 bytes).
+const NAV_WINDOW: usize = 256 + 8;
+const CSV_WINDOW: usize = 512 + 8;
+/// Text gathered before it goes to the files [bytes].
+const NAV_BLOCK: usize = 1 << 16;
 
 /// Header of `nav.csv` from [`NavWriter::create`].
 pub const CSV_HEADER: &str =
@@ -260,19 +273,20 @@ impl NavWriter {
     }
 
     /// As [`NavWriter::create_extended`], with the navigation text named `txt_name`
-    /// (e.g. KF-GINS's `KF_GINS_Navresult.nav`).
+    /// (e.g. KF-GINS's `KF_GINS_Navresult.nav`), and `nav.csv` only if `csv`.
     pub fn create_named<E: EarthModel>(
         dir: &Path,
         txt_name: &str,
         week: u32,
         earth: &E,
+        csv: bool,
     ) -> Result<Self> {
         let geometry = (earth.semi_major_axis(), earth.eccentricity_squared());
-        Self::open_named(dir, txt_name, week, Some(geometry))
+        Self::open_named(dir, txt_name, week, Some(geometry), csv)
     }
 
     fn open(dir: &Path, week: u32, extended: Option<(f64, f64)>) -> Result<Self> {
-        Self::open_named(dir, "nav.txt", week, extended)
+        Self::open_named(dir, "nav.txt", week, extended, true)
     }
 
     fn open_named(
@@ -280,29 +294,36 @@ impl NavWriter {
         txt_name: &str,
         week: u32,
         extended: Option<(f64, f64)>,
+        with_csv: bool,
     ) -> Result<Self> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
-        let open = |name: &str| -> Result<(BufWriter<File>, PathBuf)> {
+        let open = |name: &str| -> Result<(File, PathBuf)> {
             let p = dir.join(name);
             let f = File::create(&p).with_context(|| format!("cannot create {}", p.display()))?;
-            Ok((BufWriter::with_capacity(1 << 20, f), p))
+            Ok((f, p))
         };
         let (txt, txt_path) = open(txt_name)?;
-        let (mut csv, csv_path) = open("nav.csv")?;
-        let header = if extended.is_some() {
-            CSV_HEADER_EXTENDED
+        let csv = if with_csv {
+            let (mut csv, csv_path) = open("nav.csv")?;
+            let header = if extended.is_some() {
+                CSV_HEADER_EXTENDED
+            } else {
+                CSV_HEADER
+            };
+            csv.write_all(format!("{header}\n").as_bytes())
+                .with_context(|| format!("cannot write {}", csv_path.display()))?;
+            Some((csv, csv_path))
         } else {
-            CSV_HEADER
+            None
         };
-        writeln!(csv, "{header}")
-            .with_context(|| format!("cannot write {}", csv_path.display()))?;
         Ok(Self {
             txt,
             csv,
             txt_path,
-            csv_path,
-            week,
+            week: format!("{week} ").into_bytes(),
+            txt_text: TextBlock::default(),
+            csv_text: TextBlock::default(),
             line: Vec::with_capacity(256),
             rows: 0,
             extended,
@@ -328,19 +349,89 @@ impl NavWriter {
     /// Write one epoch to both files; the ECEF position and wander azimuth go to the
     /// extended CSV only. Decimals: 1 um for ECEF, 1e-9 deg for the azimuth.
     pub fn write_epoch(&mut self, epoch: &NavEpoch) -> Result<()> {
+        if !self.put_epoch(epoch) {
+            self.push_epoch(epoch);
+        }
+        self.rows += 1;
+        if self.txt_text.len() >= NAV_BLOCK || self.csv_text.len() >= NAV_BLOCK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// [`NavWriter::write_epoch`]'s lines through the windows; `false` (and nothing
+    /// counted) where [`put_nav_fields`] or [`put_field`] decline a number.
+    #[inline(always)]
+    fn put_epoch(&mut self, epoch: &NavEpoch) -> bool {
+        let s = &epoch.state;
+        let e = s.euler();
+        let week = self.week.len();
+        let txt = self.txt_text.scratch(week + NAV_WINDOW);
+        let (start, txt) = txt.split_at_mut(week);
+        start.copy_from_slice(&self.week);
+        let txt = Line {
+            bytes: window::<NAV_WINDOW>(txt, 0),
+            sep: b' ',
+        };
+        if self.csv.is_none() {
+            let mut w = txt;
+            let Some(end) = put_first_field(&mut w, 0, s.t, 6)
+                .and_then(|end| put_nav_fields(&mut w, end, s, &e))
+            else {
+                return false;
+            };
+            w.put(end, u64::from(b'\n'));
+            self.txt_text
+                .advance(week + Line::<NAV_WINDOW>::end(end) + 1);
+            return true;
+        }
+        let csv = Line {
+            bytes: window::<CSV_WINDOW>(self.csv_text.scratch(CSV_WINDOW), 0),
+            sep: b',',
+        };
+        let mut w = Twin(txt, csv);
+        let Some(end) =
+            put_first_field(&mut w, 0, s.t, 6).and_then(|end| put_nav_fields(&mut w, end, s, &e))
+        else {
+            return false;
+        };
+        w.0.put(end, u64::from(b'\n'));
+        let mut csv = w.1;
+        let csv_end = match self.extended {
+            Some(_) => {
+                let r = &epoch.r_e;
+                let azimuth = printable_lon(wrap_lon_deg(epoch.wander_azimuth), 9);
+                let Some(end) = put_field(&mut csv, end, r.x, 6)
+                    .and_then(|p| put_field(&mut csv, p, r.y, 6))
+                    .and_then(|p| put_field(&mut csv, p, r.z, 6))
+                    .and_then(|p| put_field(&mut csv, p, azimuth, 9))
+                else {
+                    return false;
+                };
+                end
+            }
+            None => end,
+        };
+        csv.put(csv_end, u64::from(b'\n'));
+        self.txt_text
+            .advance(week + Line::<NAV_WINDOW>::end(end) + 1);
+        self.csv_text.advance(Line::<CSV_WINDOW>::end(csv_end) + 1);
+        true
+    }
+
+    /// [`NavWriter::write_epoch`]'s lines through the `Vec` writers, for any numbers.
+    fn push_epoch(&mut self, epoch: &NavEpoch) {
         let s = &epoch.state;
         let row = Row::of(s);
         self.line.clear();
-        let mut b = itoa::Buffer::new();
-        self.line.extend_from_slice(b.format(self.week).as_bytes());
-        self.line.push(b' ');
+        self.line.extend_from_slice(&self.week);
         push_fixed(&mut self.line, s.t, 6);
         row.push(&mut self.line, b' ');
         self.line.push(b'\n');
-        self.txt
-            .write_all(&self.line)
-            .with_context(|| format!("cannot write {}", self.txt_path.display()))?;
-
+        self.txt_text.extend(&self.line);
+        if self.csv.is_none() {
+            return;
+        }
         self.line.clear();
         push_fixed(&mut self.line, s.t, 6);
         row.push(&mut self.line, b',');
@@ -356,21 +447,26 @@ impl NavWriter {
             }
         }
         self.line.push(b'\n');
-        self.csv
-            .write_all(&self.line)
-            .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
-        self.rows += 1;
+        self.csv_text.extend(&self.line);
+    }
+
+    /// Writes the gathered text to the files.
+    fn flush(&mut self) -> Result<()> {
+        self.txt
+            .write_all(self.txt_text.as_bytes())
+            .with_context(|| format!("cannot write {}", self.txt_path.display()))?;
+        self.txt_text.clear();
+        if let Some((csv, csv_path)) = self.csv.as_mut() {
+            csv.write_all(self.csv_text.as_bytes())
+                .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        }
+        self.csv_text.clear();
         Ok(())
     }
 
-    /// Flush both files; returns the number of epochs written.
+    /// Writes what is left to both files; returns the number of epochs written.
     pub fn finish(mut self) -> Result<u64> {
-        self.txt
-            .flush()
-            .with_context(|| format!("cannot write {}", self.txt_path.display()))?;
-        self.csv
-            .flush()
-            .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
+        self.flush()?;
         Ok(self.rows)
     }
 }

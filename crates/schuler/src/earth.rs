@@ -1,4 +1,5 @@
-//! Earth models: the WGS84 ellipsoid with normal gravity, and the textbook's sphere.
+//! Earth models: the WGS84 ellipsoid with normal gravity (TR8350.2's closed form, or
+//! the GRS80 series KF-GINS uses: [`Wgs84Series`]), and the textbook's sphere.
 //!
 //! Both are ellipsoids of revolution (the sphere has zero eccentricity), so the
 //! geometry — radii of curvature, geodetic <-> ECEF, Earth rate and transport rate in
@@ -10,6 +11,9 @@
 //! (2004) ch. 3 for radii and transport rate; Bowring (1976, 1985) for ECEF -> geodetic.
 
 use nalgebra::{Matrix3, Vector3};
+
+mod series;
+pub use series::Wgs84Series;
 
 /// Geodetic position: latitude and longitude [rad], ellipsoidal height [m].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -312,6 +316,16 @@ impl EarthModel for Wgs84 {
     /// sharing one square root.
     #[inline]
     fn local_from_sin_cos(&self, s: f64, c: f64, h: f64) -> LocalEarth {
+        Self::local_with(s, c, h, |s2, w| Self::somigliana(s2, w, h))
+    }
+}
+
+impl Wgs84 {
+    /// [`EarthModel::local_from_sin_cos`] on the WGS84 ellipsoid with the normal
+    /// gravity `gamma(sin² lat, w)` (`w = sqrt(1 − e² sin² lat)`, shared with the
+    /// radii), for the models of this ellipsoid.
+    #[inline(always)]
+    fn local_with(s: f64, c: f64, h: f64, gamma: impl FnOnce(f64, f64) -> f64) -> LocalEarth {
         let s2 = s * s;
         let w2 = 1.0 - Self::E2 * s2;
         let w = w2.sqrt();
@@ -323,7 +337,7 @@ impl EarthModel for Wgs84 {
                 meridian: Self::A * (1.0 - Self::E2) / (w2 * w),
                 prime_vertical: Self::A / w,
             },
-            g_n: Vector3::new(0.0, 0.0, Self::somigliana(s2, w, h)),
+            g_n: Vector3::new(0.0, 0.0, gamma(s2, w)),
             rotation_rate: Self::OMEGA,
         }
     }

@@ -19,7 +19,7 @@ use schuler::units::{Dimension, parse_as_or_si};
 use std::path::{Path, PathBuf};
 use vehicle::VehicleReadings;
 
-/// File names of an aided run's outputs.
+/// File names of an aided run's outputs, and which of them it writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OutputNames {
     /// Navigation result (KF-GINS text).
@@ -28,20 +28,35 @@ pub struct OutputNames {
     pub std: &'static str,
     /// Sensor errors.
     pub imu_err: &'static str,
+    /// Whether `nav.csv` is written beside the navigation result.
+    pub nav_csv: bool,
+    /// Whether the filter's diagnostics are written: `innovations.csv`,
+    /// `rejected.csv`, `consistency.json` and the report (if its settings ask).
+    pub diagnostics: bool,
+    /// Whether the start state is the first epoch written (KF-GINS writes its first
+    /// row one sample after the start).
+    pub start_epoch: bool,
 }
 
 impl OutputNames {
-    /// schuler's own names.
+    /// schuler's own names, every output.
     pub const SCHULER: OutputNames = OutputNames {
         nav: "nav.txt",
         std: "std.txt",
         imu_err: "imu_err.txt",
+        nav_csv: true,
+        diagnostics: true,
+        start_epoch: true,
     };
-    /// KF-GINS's names.
+    /// KF-GINS's names, and only KF-GINS's three files, from one sample after the
+    /// start (as KF-GINS writes them).
     pub const KF_GINS: OutputNames = OutputNames {
         nav: "KF_GINS_Navresult.nav",
         std: "KF_GINS_STD.txt",
         imu_err: "KF_GINS_IMU_ERR.txt",
+        nav_csv: false,
+        diagnostics: false,
+        start_epoch: false,
     };
 }
 

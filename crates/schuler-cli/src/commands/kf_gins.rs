@@ -7,15 +7,22 @@
 //! separated). The filter is the 21-state one with Gauss–Markov biases and scale
 //! factors, as KF-GINS's. Relative paths are taken from the working directory, as
 //! KF-GINS does.
+//!
+//! By default it behaves as KF-GINS: only its three files, no innovation gate, its
+//! normal gravity ([`schuler::earth::Wgs84Series`]), the first IMU sample at or after
+//! `starttime` as the start (its state not written: the first row is one sample
+//! later) and only the GNSS fixes after `starttime`. [`KfGinsOptions`] asks for more:
+//! the report and diagnostics, `nav.csv`, a gate, TR8350.2's gravity.
 
 use crate::aided::report::ReportSettings;
 use crate::aided::{Aiding, OutputNames};
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions};
 use crate::navigate::{NavSettings, navigate};
-use crate::options::EarthChoice;
+use crate::options::{EarthChoice, GravityChoice};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
+use schuler::earth::{Wgs84, Wgs84Series};
 use schuler::filter::integration::SensorEstimates;
 use schuler::filter::{Gate, IntegrationConfig};
 use schuler::rotation::Euler;
@@ -67,6 +74,22 @@ struct KfGinsYaml {
     antlever: [f64; 3],
 }
 
+/// What a KF-GINS run does beyond KF-GINS (the flags of `schuler nav` that apply).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct KfGinsOptions {
+    /// Write report.html, innovations.csv, rejected.csv and consistency.json too.
+    pub report: bool,
+    /// Write nav.csv beside the navigation result.
+    pub nav_csv: bool,
+    /// Innovation gate's significance level (`None` or 0: no gate, as KF-GINS).
+    pub gate: Option<f64>,
+    /// Normal gravity (`None`: KF-GINS's series).
+    pub gravity: Option<GravityChoice>,
+    /// Longest covariance propagation step [s] (`None`: 1 s; KF-GINS propagates at
+    /// every sample, which any step shorter than the sample interval reproduces).
+    pub propagation_interval: Option<f64>,
+}
+
 /// A run set up from a KF-GINS configuration.
 #[derive(Debug, Clone)]
 pub struct KfGinsRun {
@@ -74,6 +97,8 @@ pub struct KfGinsRun {
     pub settings: NavSettings,
     /// The filter, the GNSS data and the initial sensor errors.
     pub aiding: Aiding,
+    /// The gravity it navigates with.
+    pub gravity: GravityChoice,
 }
 
 fn positive(key: &str, v: &[f64]) -> Result<Vector3<f64>> {
@@ -150,8 +175,36 @@ fn noise(n: &ImuNoiseYaml, key: &dyn Fn(&str) -> String) -> Result<schuler::filt
     })
 }
 
-/// The filter of a configuration: KF-GINS's 21 states with its prior.
-fn integration(y: &KfGinsYaml, key: &dyn Fn(&str) -> String) -> Result<IntegrationConfig> {
+/// The innovation gate of a significance level `level` (`None` or 0: none, as
+/// KF-GINS).
+fn gate(level: Option<f64>) -> Result<Gate> {
+    match level {
+        None | Some(0.0) => Ok(Gate::Off),
+        Some(a) if a > 0.0 && a < 1.0 => Ok(Gate::Level(a)),
+        Some(a) => bail!("--gate must be a significance level in [0, 1), got {a}"),
+    }
+}
+
+/// The covariance propagation step [s] of `--propagation-interval` (default 1 s:
+/// the covariance is propagated once a second and at every update, where KF-GINS
+/// propagates it at every sample; on `tests/data/drive9min` per-sample propagation
+/// costs 7x the run time for standard deviations closer to KF-GINS's, see
+/// `tests/kf_gins_parity.rs`).
+fn propagation_interval(s: Option<f64>) -> Result<f64> {
+    match s {
+        None => Ok(1.0),
+        Some(s) if s > 0.0 => Ok(s),
+        Some(s) => bail!("--propagation-interval must be positive, got {s} s"),
+    }
+}
+
+/// The filter of a configuration: KF-GINS's 21 states with its prior, the gate and
+/// the covariance propagation step.
+fn integration(
+    y: &KfGinsYaml,
+    key: &dyn Fn(&str) -> String,
+    (gate, propagation_interval): (Gate, f64),
+) -> Result<IntegrationConfig> {
     let noise = noise(&y.imunoise, key)?;
     let init_std =
         |k: &str, v: Option<[f64; 3]>, default: Vector3<f64>, unit: f64| -> Result<Vector3<f64>> {
@@ -167,10 +220,9 @@ fn integration(y: &KfGinsYaml, key: &dyn Fn(&str) -> String) -> Result<Integrati
         noise,
         scale_factors: true,
         lever_arm: Vector3::from(y.antlever),
-        // KF-GINS has no innovation test; keep ours on at its default level.
-        gate: Gate::Level(1e-4),
+        gate,
         reset_after: 5,
-        propagation_interval: 1.0,
+        propagation_interval,
         init_pos_std: positive(&key("initposstd"), &y.initposstd)?,
         init_vel_std: positive(&key("initvelstd"), &y.initvelstd)?,
         init_att_std: positive(&key("initattstd"), &y.initattstd)?.map(f64::to_radians),
@@ -179,12 +231,14 @@ fn integration(y: &KfGinsYaml, key: &dyn Fn(&str) -> String) -> Result<Integrati
     })
 }
 
-/// Read and check a KF-GINS configuration.
-pub fn load(path: &Path) -> Result<KfGinsRun> {
+/// Read and check a KF-GINS configuration, with the options `opts`.
+pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
     let y = read_yaml(path)?;
     let key = |k: &str| format!("{}: {k}", path.display());
     let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)?;
-    fixes.retain(|f| f.t >= y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));
+    // KF-GINS skips the fixes up to and including `starttime` (its start is the
+    // configured state, not a fix).
+    fixes.retain(|f| f.t > y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));
     let settings = NavSettings {
         imu: y.imupath.clone(),
         read: ImuReadOptions {
@@ -212,11 +266,25 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
     };
     let aiding = Aiding {
         fixes,
-        filter: FilterConfig::new(integration(&y, &key)?),
-        names: OutputNames::KF_GINS,
+        filter: FilterConfig::new(integration(
+            &y,
+            &key,
+            (
+                gate(opts.gate)?,
+                propagation_interval(opts.propagation_interval)?,
+            ),
+        )?),
+        names: OutputNames {
+            nav_csv: opts.nav_csv,
+            diagnostics: opts.report,
+            ..OutputNames::KF_GINS
+        },
         outage_test: None,
         baro: Vec::new(),
-        report: ReportSettings::default(),
+        report: ReportSettings {
+            html: opts.report,
+            ..ReportSettings::default()
+        },
         vehicle: Default::default(),
         initial_errors: SensorEstimates {
             gyro_bias: Vector3::from(y.initgyrbias) * DEG_PER_H,
@@ -226,26 +294,39 @@ pub fn load(path: &Path) -> Result<KfGinsRun> {
             ..SensorEstimates::default()
         },
     };
-    Ok(KfGinsRun { settings, aiding })
+    Ok(KfGinsRun {
+        settings,
+        aiding,
+        gravity: opts.gravity.unwrap_or(GravityChoice::KfGins),
+    })
 }
 
-/// Run a KF-GINS configuration end to end.
-pub fn run(path: &Path) -> Result<()> {
+/// Run a KF-GINS configuration end to end, with the options `opts`.
+pub fn run(path: &Path, opts: &KfGinsOptions) -> Result<()> {
     let started = Instant::now();
-    let KfGinsRun { settings, aiding } = load(path)?;
+    let KfGinsRun {
+        settings,
+        aiding,
+        gravity,
+    } = load(path, opts)?;
     let mut reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
     let start = Start {
         estimates: aiding.initial_errors,
         ..settings.start()
     };
-    let summary = navigate(
-        schuler::earth::Wgs84,
-        &settings,
-        Some(&aiding),
-        start,
-        &mut reader,
-        |_| {},
-    )?;
+    let summary = match gravity {
+        GravityChoice::KfGins => navigate(
+            Wgs84Series,
+            &settings,
+            Some(&aiding),
+            start,
+            &mut reader,
+            |_| {},
+        )?,
+        GravityChoice::Tr8350 => {
+            navigate(Wgs84, &settings, Some(&aiding), start, &mut reader, |_| {})?
+        }
+    };
     let c = summary.nav.counts;
     println!(
         "KF-GINS configuration {}: {} samples, {} GNSS fixes ({} position updates, {} rejected, {} outside the IMU data) in {:.2} s; wrote {} epochs to {}",

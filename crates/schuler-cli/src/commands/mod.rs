@@ -17,7 +17,20 @@ pub mod vertical;
 /// ([`kf_gins::run`]), anything else as [`nav::run`].
 pub fn run_nav(args: nav::NavArgs) -> anyhow::Result<()> {
     match &args.kf_gins_config {
-        Some(path) => kf_gins::run(path),
+        Some(path) => kf_gins::run(
+            path,
+            &kf_gins::KfGinsOptions {
+                report: args.report,
+                nav_csv: args.nav_csv,
+                gate: args.aiding.gate,
+                gravity: args.gravity,
+                propagation_interval: crate::options::quantity(
+                    "propagation-interval",
+                    &args.aiding.propagation_interval,
+                    schuler::units::Dimension::Time,
+                )?,
+            },
+        ),
         None => nav::run(args),
     }
 }

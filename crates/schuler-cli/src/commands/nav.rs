@@ -19,11 +19,11 @@ use crate::alignment::AlignOptions;
 use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
-use crate::options::{EarthChoice, GradeChoice, MechanizationChoice, Triple, rate};
+use crate::options::{EarthChoice, GradeChoice, GravityChoice, MechanizationChoice, Triple, rate};
 use anyhow::{Context, Result, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
-use schuler::earth::{Geodetic, Sphere, Wgs84};
+use schuler::earth::{Geodetic, Sphere, Wgs84, Wgs84Series};
 use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
 use schuler::session::{MechanizationConfig, Prior, Start};
@@ -67,6 +67,17 @@ pub struct NavArgs {
     /// Earth model.
     #[arg(long, value_enum)]
     pub earth: Option<EarthChoice>,
+    /// Normal gravity on WGS84: tr8350 (TR8350.2's closed form, the default) or
+    /// kf-gins (the GRS80 series KF-GINS uses, the default of --kf-gins-config).
+    #[arg(long, value_enum)]
+    pub gravity: Option<GravityChoice>,
+    /// With --kf-gins-config: also write report.html (and innovations.csv,
+    /// rejected.csv, consistency.json), which KF-GINS does not.
+    #[arg(long, requires = "kf_gins_config")]
+    pub report: bool,
+    /// With --kf-gins-config: also write nav.csv beside KF_GINS_Navresult.nav.
+    #[arg(long, requires = "kf_gins_config")]
+    pub nav_csv: bool,
     /// How to read the IMU log: format, layout, columns, units, clock, axes.
     #[command(flatten)]
     pub input: ImuInputOptions,
@@ -96,8 +107,9 @@ pub struct NavArgs {
     #[arg(long, value_enum)]
     pub init: Option<InitChoice>,
     /// Run a KF-GINS configuration file (its paths, initial state, IMU noise and lever
-    /// arm, in its units) and write KF-GINS's output files into its outputpath; the
-    /// other options do not apply.
+    /// arm, in its units) as KF-GINS does and write KF-GINS's three output files into
+    /// its outputpath; of the other options only --report, --nav-csv, --gate,
+    /// --gravity and --propagation-interval apply.
     #[arg(long, value_name = "FILE.yaml", conflicts_with_all = ["imu", "config"])]
     pub kf_gins_config: Option<PathBuf>,
     /// Alignment options (with --align).
@@ -124,6 +136,7 @@ struct NavConfig {
     output_rate: Option<f64>,
     out: Option<PathBuf>,
     earth: Option<EarthChoice>,
+    gravity: Option<GravityChoice>,
     week: Option<u32>,
     mechanization: Option<MechanizationChoice>,
     auto_latitude: Option<f64>,
@@ -293,7 +306,12 @@ pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
             .clone()
             .or(cfg.out.clone())
             .unwrap_or_else(|| PathBuf::from(".")),
-        earth: args.earth.or(cfg.earth).unwrap_or_default(),
+        earth: args
+            .earth
+            .or(cfg.earth)
+            .unwrap_or_default()
+            .with_gravity(args.gravity.or(cfg.gravity))
+            .map_err(anyhow::Error::msg)?,
         week: args.week.or(cfg.week).unwrap_or(0),
         mechanization: mechanization_config(&args, &cfg)?,
         out_bag: args.bag.out_bag.clone(),
@@ -486,6 +504,7 @@ impl Begin<'_> {
     {
         match self.settings.earth {
             EarthChoice::Wgs84 => self.navigate_on(Wgs84, samples, on_sample),
+            EarthChoice::Wgs84Series => self.navigate_on(Wgs84Series, samples, on_sample),
             EarthChoice::Sphere | EarthChoice::SphereFixed => {
                 let rotating = self.settings.earth == EarthChoice::Sphere;
                 self.navigate_on(Sphere::textbook(rotating), samples, on_sample)

@@ -31,6 +31,7 @@
 use crate::drive::{imu_err_row, push_table_row};
 use crate::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
 use crate::output::{push_nav_fields, put_imu_increments, put_nav_fields};
+use crate::text_block::{TextBlock, window};
 use anyhow::{Context, Result};
 use schuler::sim::receivers::GnssFix;
 use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
@@ -97,61 +98,6 @@ const IMU_WINDOW: usize = 256 + 8;
 const NAV_WINDOW: usize = 256 + 8;
 const CSV_WINDOW: usize = 512 + 8;
 
-/// The text of one file for one block, `bytes[..len]`. The bytes past `len` are
-/// scratch, kept from block to block, that a line is stored into in whole words
-/// ([`crate::fixed::Words`]) before it counts: no capacity check per number, no copy
-/// of the line.
-#[derive(Default)]
-struct Text {
-    bytes: Vec<u8>,
-    len: usize,
-}
-
-impl Text {
-    fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// Make `room` bytes of scratch after the text. An empty text takes fresh zeroed
-    /// memory (pages the system zeroes when first touched, no writes of zeros).
-    #[inline(always)]
-    fn reserve(&mut self, room: usize) {
-        let end = self.len + room;
-        if self.bytes.len() < end {
-            let size = end.max(2 * self.bytes.len());
-            if self.len == 0 {
-                self.bytes = vec![0; size];
-            } else {
-                self.bytes.resize(size, 0);
-            }
-        }
-    }
-
-    /// The first `room` bytes of scratch after the text.
-    #[inline(always)]
-    fn scratch(&mut self, room: usize) -> &mut [u8] {
-        self.reserve(room);
-        &mut self.bytes[self.len..self.len + room]
-    }
-
-    /// Count `n` bytes of the scratch as text.
-    #[inline(always)]
-    fn advance(&mut self, n: usize) {
-        self.len += n;
-        debug_assert!(self.len <= self.bytes.len());
-    }
-
-    /// Append `text`.
-    fn extend(&mut self, text: &[u8]) {
-        self.scratch(text.len()).copy_from_slice(text);
-        self.advance(text.len());
-    }
-
-    fn as_bytes(&self) -> &[u8] {
-        &self.bytes[..self.len]
-    }
-}
-
 /// The lines of `epochs` in `imu.txt` and `imu.csv` (`t dtheta_xyz dvel_xyz`, every
 /// number in shortest round-trip form), `truth.nav` (week 0, then `t lat lon h vn ve
 /// vd roll pitch yaw`) and `truth.csv` (the same after the week, then `w_ib_b` and
@@ -160,10 +106,10 @@ impl Text {
 /// the IMU line's when it is the same f64.
 fn epoch_lines(
     epochs: &[ImuEpoch],
-    imu_txt: &mut Text,
-    imu_csv: &mut Text,
-    nav: &mut Text,
-    csv: &mut Text,
+    imu_txt: &mut TextBlock,
+    imu_csv: &mut TextBlock,
+    nav: &mut TextBlock,
+    csv: &mut TextBlock,
 ) {
     let (mut time, mut num) = (zmij::Buffer::new(), zmij::Buffer::new());
     let mut rest = epochs;
@@ -229,12 +175,6 @@ fn epoch_lines(
         csv.extend(&csv_line);
         rest = &rest[k + 1..];
     }
-}
-
-/// The `N` bytes of `scratch` from `at`.
-#[inline(always)]
-fn window<const N: usize>(scratch: &mut [u8], at: usize) -> &mut [u8; N] {
-    (&mut scratch[at..at + N]).try_into().expect("N bytes")
 }
 
 /// The `truth.nav` line of `e` after its week and the `truth.csv` line, with time
@@ -335,10 +275,10 @@ fn gnss_lines(fix: &GnssFix, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
 /// to block).
 #[derive(Default)]
 struct BlockText {
-    imu_txt: Text,
-    imu_csv: Text,
-    truth_nav: Text,
-    truth_csv: Text,
+    imu_txt: TextBlock,
+    imu_csv: TextBlock,
+    truth_nav: TextBlock,
+    truth_csv: TextBlock,
     gnss_txt: Vec<u8>,
     gnss_csv: Vec<u8>,
     baro_csv: Vec<u8>,
@@ -597,7 +537,7 @@ mod tests {
         let [mut imu_txt, mut imu_csv, mut nav, mut csv] = [(); 4].map(|()| Vec::new());
         previous::imu_lines(&block.imu, &mut imu_txt, &mut imu_csv);
         previous::truth_lines(&block.imu, &mut nav, &mut csv);
-        let same = |name: &str, got: &Text, want: &[u8]| {
+        let same = |name: &str, got: &TextBlock, want: &[u8]| {
             assert!(
                 got.as_bytes() == want,
                 "{name} differs:\n{}\nwanted\n{}",

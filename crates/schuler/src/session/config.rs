@@ -250,7 +250,8 @@ pub struct SessionConfig {
     /// barometer aids.
     pub baro_loop: Option<BaroLoopConfig>,
     /// Cadence [Hz] of the filter's snapshots (sensor errors, covariance, NEES
-    /// against a truth) kept for reports; default 1 Hz.
+    /// against a truth) kept for reports; default 1 Hz; 0: none (the forward run
+    /// then keeps nothing per epoch: constant memory).
     pub snapshot_rate: f64,
     /// The envelope checked at every output epoch; `None`: no check (space, missiles).
     pub envelope: Option<Envelope>,
@@ -401,7 +402,7 @@ impl SessionConfig {
             positive("output_rate", r)?;
         }
         non_negative("reorder_window", self.reorder_window)?;
-        positive("snapshot_rate", self.snapshot_rate)?;
+        non_negative("snapshot_rate", self.snapshot_rate)?;
         if let Some(e) = &self.envelope
             && !(e.min_height < e.max_height && e.max_speed > 0.0)
         {

@@ -235,6 +235,7 @@ impl<E: EarthModel> Session<E> {
                 events: VecDeque::new(),
                 snapshots: config
                     .filter
+                    .filter(|_| config.snapshot_rate > 0.0)
                     .map(|_| SnapshotTaker::new(config.snapshot_rate, Vec::new())),
                 samples: 0,
                 t_first: f64::NAN,
