@@ -9,7 +9,7 @@ use crate::columns::{Columns, INNOVATIONS, NAV, SENSOR, STD};
 use anyhow::{Result, bail};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use schuler::earth::{Sphere, Wgs84};
+use schuler::earth::{Sphere, Wgs84, Wgs84Series};
 use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::{Epoch, Event, Finished, Session};
@@ -51,6 +51,8 @@ impl Plan {
 pub enum AnySession {
     /// WGS84.
     Wgs84(Session<Wgs84>),
+    /// WGS84 with KF-GINS's gravity series (`gravity="kf-gins"`).
+    Wgs84Series(Session<Wgs84Series>),
     /// The textbook sphere, rotating or not.
     Sphere(Session<Sphere>),
 }
@@ -60,6 +62,7 @@ macro_rules! each {
     ($session:expr, $s:ident => $body:expr) => {
         match $session {
             AnySession::Wgs84($s) => $body,
+            AnySession::Wgs84Series($s) => $body,
             AnySession::Sphere($s) => $body,
         }
     };
@@ -71,6 +74,9 @@ impl AnySession {
         let (s, a) = (&plan.settings, plan.aiding.as_ref());
         Ok(match s.earth {
             EarthChoice::Wgs84 => Self::Wgs84(open_session(Wgs84, s, a, s.start())?),
+            EarthChoice::Wgs84Series => {
+                Self::Wgs84Series(open_session(Wgs84Series, s, a, s.start())?)
+            }
             EarthChoice::Sphere => {
                 Self::Sphere(open_session(Sphere::textbook(true), s, a, s.start())?)
             }
