@@ -384,6 +384,15 @@ pub struct Driven {
     pub heading_settled: Option<(f64, f64)>,
 }
 
+/// Closes the trajectory files and the result bag; the number of epochs written.
+fn close_trajectory(nav: NavWriter, bag: Option<ResultBag>) -> Result<u64> {
+    let epochs = nav.finish()?;
+    if let Some(bag) = bag {
+        bag.finish()?;
+    }
+    Ok(epochs)
+}
+
 /// The writer thread's own error, after a hand-over to it failed.
 fn writer_error(pipe: WriterThread) -> anyhow::Error {
     match pipe.join() {
@@ -447,10 +456,7 @@ where
         Ok(f) => f,
         Err(e) => {
             // What was written stays whole: the files are closed before the error.
-            let epochs = out.nav.finish()?;
-            if let Some(bag) = out.bag {
-                bag.finish()?;
-            }
+            let epochs = close_trajectory(out.nav, out.bag)?;
             if let Some(files) = out.filter {
                 files.finish(dir)?;
             }
@@ -461,10 +467,7 @@ where
             )));
         }
     };
-    let epochs = out.nav.finish()?;
-    if let Some(bag) = out.bag {
-        bag.finish()?;
-    }
+    let epochs = close_trajectory(out.nav, out.bag)?;
     let failure = failure.map(|e| {
         e.context(format!(
             "stopped after {} samples; {epochs} epochs up to t = {} were written to {}",
