@@ -159,25 +159,8 @@ fn imu_covariances_set_the_noise_model() {
         ],
     );
     let (text, out) = (dir.path().join("text"), dir.path().join("bag"));
-    assert_cmd::Command::cargo_bin("schuler")
-        .expect("binary")
-        .arg("nav")
-        .arg("--imu")
-        .arg(sim.join("imu.txt"))
-        .arg("--gnss")
-        .arg(sim.join("gnss.txt"))
-        .arg("--gnss-vel")
-        .arg(sim.join("gnss.csv"))
-        .arg("--baro")
-        .arg(sim.join("baro.csv"))
-        .arg("--odometer")
-        .arg(sim.join("odometer.txt"))
-        .args(common::bag::COMMON)
-        .args(["--arw", "0.15 deg/sqrt(h)", "--vrw", "0.1 m/s/sqrt(h)"])
-        .arg("--out")
-        .arg(&text)
-        .assert()
-        .success();
+    let noise = ["--arw", "0.15 deg/sqrt(h)", "--vrw", "0.1 m/s/sqrt(h)"];
+    common::bag::nav_text_with(&sim, &text, &noise).success();
     let a = nav_bag(&bag, &out, &[]).success();
     let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
     assert!(

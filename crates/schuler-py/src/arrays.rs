@@ -2,6 +2,7 @@
 //! each value checked as the file readers check it; errors name the array, the
 //! 1-based row and the column.
 
+use crate::columns::GNSS;
 use nalgebra::Vector3;
 use numpy::ndarray::ArrayView1;
 use schuler::earth::Geodetic;
@@ -140,23 +141,8 @@ impl ImuArrays<'_> {
 /// [m/s] with their standard deviations (a row with any of them NaN has none).
 pub fn gnss_fixes(cols: &[ArrayView1<'_, f64>]) -> Result<Vec<GnssFix>, InputError> {
     const WHAT: &str = "<gnss array>";
-    const NAMES: [&str; 13] = [
-        "t_s",
-        "lat_deg",
-        "lon_deg",
-        "h_m",
-        "std_n_m",
-        "std_e_m",
-        "std_d_m",
-        "vn_mps",
-        "ve_mps",
-        "vd_mps",
-        "std_vn_mps",
-        "std_ve_mps",
-        "std_vd_mps",
-    ];
     if !(cols.len() == 7 || cols.len() == 13) {
-        let msg = format!("7 or 13 columns ({}), got {}", NAMES.join(", "), cols.len());
+        let msg = format!("7 or 13 columns ({}), got {}", GNSS.join(", "), cols.len());
         return Err(err(InputErrorKind::ColumnCount, WHAT, 0, "columns", msg));
     }
     let n = cols[0].len();
@@ -169,12 +155,12 @@ pub fn gnss_fixes(cols: &[ArrayView1<'_, f64>]) -> Result<Vec<GnssFix>, InputErr
                     InputErrorKind::ColumnCount,
                     WHAT,
                     i,
-                    NAMES[k],
+                    GNSS[k],
                     "column too short".into(),
                 )
             })?;
             v[k] = if k < 7 {
-                finite(WHAT, i, NAMES[k], x)?
+                finite(WHAT, i, GNSS[k], x)?
             } else {
                 x
             };

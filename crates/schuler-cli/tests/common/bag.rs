@@ -55,6 +55,11 @@ pub const COMMON: [&str; 13] = [
 /// `schuler nav` on the text logs of `sim` (IMU, GNSS with velocity, barometer,
 /// odometer) into `out`.
 pub fn nav_text(sim: &Path, out: &Path) -> assert_cmd::assert::Assert {
+    nav_text_with(sim, out, &[])
+}
+
+/// [`nav_text`] with `extra` flags after [`COMMON`].
+pub fn nav_text_with(sim: &Path, out: &Path, extra: &[&str]) -> assert_cmd::assert::Assert {
     assert_cmd::Command::cargo_bin("schuler")
         .expect("binary")
         .arg("nav")
@@ -69,6 +74,7 @@ pub fn nav_text(sim: &Path, out: &Path) -> assert_cmd::assert::Assert {
         .arg("--odometer")
         .arg(sim.join("odometer.txt"))
         .args(COMMON)
+        .args(extra)
         .arg("--out")
         .arg(out)
         .assert()
