@@ -355,8 +355,7 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json = serde_json::to_string_pretty(&to_json(a))?;
     let path = dir.join("align.json");
-    std::fs::write(&path, json + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    crate::line_file::write_whole(&path, json + "\n")?;
     let Some(fine) = &a.fine else { return Ok(()) };
     let mut csv = String::from(
         "t,roll_std_deg,pitch_std_deg,yaw_std_deg,gyro_bias_std_x_dph,gyro_bias_std_y_dph,gyro_bias_std_z_dph,accel_bias_std_x_mgal,accel_bias_std_y_mgal,accel_bias_std_z_mgal\n",
@@ -372,7 +371,7 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
         );
     }
     let path = dir.join("align_convergence.csv");
-    std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::line_file::write_whole(&path, csv)?;
     let t: Vec<f64> = fine.convergence.iter().map(|c| c.t - a.t_start).collect();
     let col = |i: usize| -> Vec<f64> {
         fine.convergence

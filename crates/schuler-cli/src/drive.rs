@@ -9,10 +9,11 @@
 use crate::aided::record::InnovationLog;
 use crate::bag::output::ResultBag;
 use crate::fixed::{Words, put_field};
+use crate::line_file::{LineFile, write_whole};
 use crate::output::{NavEpoch, NavWriter, push_fixed};
 use crate::text_block::{TextBlock, put_first_field};
 use crate::writer_thread::WriterThread;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use schuler::earth::EarthModel;
 use schuler::filter::SensorEstimates;
 use schuler::filter::integration::SkipReason;
@@ -20,15 +21,12 @@ use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session};
 use schuler::units::{DEG_PER_H, MGAL, PPM};
-use std::fs::File;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Text writer for `std.txt` and `imu_err.txt`, through the fast row writer
 /// ([`TextBlock`]).
 pub struct Table {
-    file: File,
-    path: PathBuf,
+    file: LineFile,
     text: TextBlock,
     line: Vec<u8>,
 }
@@ -44,12 +42,8 @@ const TABLE_BLOCK: usize = 1 << 16;
 impl Table {
     /// Creates `dir/name`.
     pub fn create(dir: &Path, name: &str) -> Result<Self> {
-        let path = dir.join(name);
-        let file =
-            File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
         Ok(Self {
-            file,
-            path,
+            file: LineFile::create(dir.join(name))?,
             text: TextBlock::default(),
             line: Vec::with_capacity(512),
         })
@@ -79,9 +73,7 @@ impl Table {
 
     /// Writes the gathered text to the file.
     fn flush(&mut self) -> Result<()> {
-        self.file
-            .write_all(self.text.as_bytes())
-            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        self.file.append(self.text.as_bytes())?;
         self.text.clear();
         Ok(())
     }
@@ -249,8 +241,7 @@ impl FilterFiles {
         for (_, r) in &self.refused {
             s.push_str(r);
         }
-        let path = dir.join("rejected.csv");
-        std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
+        write_whole(&dir.join("rejected.csv"), s)?;
         Ok(Some(innovations))
     }
 }
@@ -421,6 +412,12 @@ where
     let mut n = 0u64;
     let mut failure: Option<anyhow::Error> = None;
     for s in samples {
+        // A signal stops the run here, as a read error does: everything before is
+        // written, every file ends on a whole line.
+        if let Some(i) = crate::interrupt::requested() {
+            failure = Some(i.into());
+            break;
+        }
         let pushed = s
             .map_err(anyhow::Error::new)
             .and_then(|s| session.push_imu(s).map_err(anyhow::Error::new));

@@ -10,6 +10,8 @@ pub mod drive;
 pub mod fixed;
 pub mod formats;
 pub mod imu_input;
+pub mod interrupt;
+pub mod line_file;
 pub mod navigate;
 pub mod options;
 pub mod output;

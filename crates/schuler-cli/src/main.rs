@@ -55,10 +55,17 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {}", chain_message(&e));
-            ExitCode::FAILURE
-        }
+        Err(e) => match schuler_cli::interrupt::find(&e) {
+            // Not a failure of the program: what it says is how far the files got.
+            Some(i) => {
+                eprintln!("{}", chain_message(&e));
+                ExitCode::from(i.exit_code())
+            }
+            None => {
+                eprintln!("error: {}", chain_message(&e));
+                ExitCode::FAILURE
+            }
+        },
     }
 }
 

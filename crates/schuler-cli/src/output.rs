@@ -21,12 +21,12 @@ use schuler::earth::{EarthModel, Geodetic};
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::Path;
 
 pub use crate::fixed::push_fixed;
 use crate::fixed::{Line, Twin, Words, put_bytes, put_field};
+use crate::line_file::{LineFile, LineWriter};
 use crate::text_block::{TextBlock, put_first_field, window};
 use std::f64::consts::FRAC_PI_2;
 
@@ -226,10 +226,9 @@ fn ecef_of(p: &Geodetic, a: f64, e2: f64) -> Vector3<f64> {
 /// Writes `nav.txt` (KF-GINS) and `nav.csv` side by side (or the text alone),
 /// through the fast row writer ([`TextBlock`]).
 pub struct NavWriter {
-    txt: File,
-    /// `nav.csv` and its path, unless the text is written alone.
-    csv: Option<(File, PathBuf)>,
-    txt_path: PathBuf,
+    txt: LineFile,
+    /// `nav.csv`, unless the text is written alone.
+    csv: Option<LineFile>,
     /// `week` and a space: the start of every `nav.txt` line.
     week: Vec<u8>,
     txt_text: TextBlock,
@@ -298,29 +297,22 @@ impl NavWriter {
     ) -> Result<Self> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
-        let open = |name: &str| -> Result<(File, PathBuf)> {
-            let p = dir.join(name);
-            let f = File::create(&p).with_context(|| format!("cannot create {}", p.display()))?;
-            Ok((f, p))
-        };
-        let (txt, txt_path) = open(txt_name)?;
+        let txt = LineFile::create(dir.join(txt_name))?;
         let csv = if with_csv {
-            let (mut csv, csv_path) = open("nav.csv")?;
+            let mut csv = LineFile::create(dir.join("nav.csv"))?;
             let header = if extended.is_some() {
                 CSV_HEADER_EXTENDED
             } else {
                 CSV_HEADER
             };
-            csv.write_all(format!("{header}\n").as_bytes())
-                .with_context(|| format!("cannot write {}", csv_path.display()))?;
-            Some((csv, csv_path))
+            csv.append(format!("{header}\n").as_bytes())?;
+            Some(csv)
         } else {
             None
         };
         Ok(Self {
             txt,
             csv,
-            txt_path,
             week: format!("{week} ").into_bytes(),
             txt_text: TextBlock::default(),
             csv_text: TextBlock::default(),
@@ -452,13 +444,10 @@ impl NavWriter {
 
     /// Writes the gathered text to the files.
     fn flush(&mut self) -> Result<()> {
-        self.txt
-            .write_all(self.txt_text.as_bytes())
-            .with_context(|| format!("cannot write {}", self.txt_path.display()))?;
+        self.txt.append(self.txt_text.as_bytes())?;
         self.txt_text.clear();
-        if let Some((csv, csv_path)) = self.csv.as_mut() {
-            csv.write_all(self.csv_text.as_bytes())
-                .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        if let Some(csv) = self.csv.as_mut() {
+            csv.append(self.csv_text.as_bytes())?;
         }
         self.csv_text.clear();
         Ok(())
@@ -473,8 +462,7 @@ impl NavWriter {
 
 /// Write states as a KF-GINS navigation text file (week 0), e.g. a simulation's truth.
 pub fn write_truth_text(path: &Path, states: impl Iterator<Item = NavState>) -> Result<()> {
-    let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = BufWriter::with_capacity(1 << 20, f);
+    let mut w = LineWriter::create(path)?;
     let mut line = Vec::with_capacity(256);
     for s in states {
         line.clear();
@@ -482,11 +470,9 @@ pub fn write_truth_text(path: &Path, states: impl Iterator<Item = NavState>) -> 
         push_fixed(&mut line, s.t, 6);
         Row::of(&s).push(&mut line, b' ');
         line.push(b'\n');
-        w.write_all(&line)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        w.write_all(&line)?;
     }
-    w.flush()
-        .with_context(|| format!("cannot write {}", path.display()))
+    w.finish()
 }
 
 /// How [`push_imu_line`] prints the numbers of an IMU line.
@@ -559,18 +545,15 @@ pub fn write_imu_text(
     samples: impl Iterator<Item = ImuSample>,
     digits: usize,
 ) -> Result<()> {
-    let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = BufWriter::with_capacity(1 << 20, f);
+    let mut w = LineWriter::create(path)?;
     let mut line = Vec::with_capacity(256);
     for s in samples {
         line.clear();
         push_imu_line(&mut line, &s, b' ', ImuDigits::Significant(digits));
         line.push(b'\n');
-        w.write_all(&line)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        w.write_all(&line)?;
     }
-    w.flush()
-        .with_context(|| format!("cannot write {}", path.display()))
+    w.finish()
 }
 
 /// Header of `errors.csv`.
@@ -596,9 +579,7 @@ pub fn error_fields(e: &EpochErrors) -> [f64; 10] {
 
 /// Writes `errors.csv`: one row per matched epoch, shortest round-trip numbers.
 pub fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = LineWriter::create(path)?;
     let mut line = String::with_capacity(256);
     use std::fmt::Write as _;
     writeln!(w, "{ERRORS_CSV_HEADER}")?;
@@ -611,8 +592,7 @@ pub fn write_errors_csv(path: &Path, errors: &[EpochErrors]) -> Result<()> {
         let _ = writeln!(line, ",{}", u8::from(e.interpolated));
         w.write_all(line.as_bytes())?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 #[cfg(test)]

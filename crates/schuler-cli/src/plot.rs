@@ -17,7 +17,7 @@
 //! ```
 
 use crate::report::escape as esc;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -158,7 +158,7 @@ impl Plot {
 
     /// Writes the SVG to `path`.
     pub fn write(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_svg()).with_context(|| format!("writing {}", path.display()))
+        crate::line_file::write_whole(path, self.to_svg())
     }
 
     /// Renders the plot as a standalone SVG document.

@@ -29,7 +29,7 @@
 //! ```
 
 use crate::plot::Plot;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -268,7 +268,7 @@ impl Report {
 
     /// Writes the HTML document to `path`.
     pub fn write(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_html()).with_context(|| format!("writing {}", path.display()))
+        crate::line_file::write_whole(path, self.to_html())
     }
 }
 

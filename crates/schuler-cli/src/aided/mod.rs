@@ -822,5 +822,5 @@ pub fn report_outage_test(
     let text = serde_json::to_string_pretty(
         &serde_json::json!({ "outages": json, "rms_of_maxima": rms }),
     )?;
-    std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+    crate::line_file::write_whole(&path, text + "\n")
 }

@@ -15,12 +15,12 @@
 //! sensor errors with their standard deviations and, against a truth, the normalized
 //! estimation errors squared (NEES) of position, velocity and attitude.
 
-use anyhow::{Context, Result, bail};
+use crate::line_file::LineWriter;
+use anyhow::{Result, bail};
 use schuler::filter::integration::Innovation;
 use schuler::filter::measurement::Kind;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::Path;
 
 /// Components `innovations.csv` holds per row (every measurement kind has at most 3).
 pub const MAX_COMPONENTS: usize = 3;
@@ -78,8 +78,7 @@ impl InnovationRow {
 /// Streams `innovations.csv` and keeps the rows for the report.
 #[derive(Debug)]
 pub struct InnovationLog {
-    w: BufWriter<File>,
-    path: PathBuf,
+    w: LineWriter,
     line: String,
     /// Every row written, in time order.
     pub rows: Vec<InnovationRow>,
@@ -88,14 +87,10 @@ pub struct InnovationLog {
 impl InnovationLog {
     /// Creates `dir/innovations.csv` with its header.
     pub fn create(dir: &Path) -> Result<Self> {
-        let path = dir.join("innovations.csv");
-        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
-        let mut w = BufWriter::with_capacity(1 << 16, f);
-        writeln!(w, "{INNOVATIONS_HEADER}")
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        let mut w = LineWriter::create(dir.join("innovations.csv"))?;
+        writeln!(w, "{INNOVATIONS_HEADER}")?;
         Ok(Self {
             w,
-            path,
             line: String::with_capacity(256),
             rows: Vec::new(),
         })
@@ -128,18 +123,15 @@ impl InnovationLog {
             }
         }
         self.line.push('\n');
-        self.w
-            .write_all(self.line.as_bytes())
-            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        self.w.write_all(self.line.as_bytes())?;
         self.rows.push(r);
         Ok(())
     }
 
     /// Flushes the file; the rows stay for the report.
     pub fn finish(&mut self) -> Result<()> {
-        self.w
-            .flush()
-            .with_context(|| format!("cannot write {}", self.path.display()))
+        // Every row ends on a newline: all of them go to the file.
+        Ok(self.w.flush()?)
     }
 }
 

@@ -366,7 +366,7 @@ impl Ctx<'_> {
             }
             s.push('\n');
         }
-        std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
+        crate::line_file::write_whole(&path, s)?;
         Ok(format!("report/{name}"))
     }
 }
@@ -391,8 +391,7 @@ pub fn write(out: &Path, html: bool, data: &ReportData) -> Result<String> {
     let nees = has_truth.then(|| nees_tests(data.samples));
     let path = out.join("consistency.json");
     let text = serde_json::to_string_pretty(&consistency_json(&nis, nees.as_ref()))?;
-    std::fs::write(&path, text + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    crate::line_file::write_whole(&path, text + "\n")?;
     let mut printed = consistency_text(&nis, nees.as_ref());
     if html {
         let ctx = Ctx {

@@ -683,7 +683,7 @@ fn noise_toml(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String {
 /// Writes `text` to `dir/name`.
 fn write(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
     let path = dir.join(name);
-    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::line_file::write_whole(&path, text)?;
     Ok(path)
 }
 

@@ -270,8 +270,7 @@ pub fn run(args: Args) -> Result<()> {
     write_errors_csv(&args.out.join("errors.csv"), &result)?;
     let summary = summary(&cfg, &result);
     let text = serde_json::to_string_pretty(&summary).context("encoding summary.json")?;
-    std::fs::write(args.out.join("summary.json"), text + "\n")
-        .with_context(|| format!("writing {}", args.out.join("summary.json").display()))?;
+    crate::line_file::write_whole(&args.out.join("summary.json"), text + "\n")?;
     write_plots(&args.out, &cfg, &result)?;
     let period = summary["schuler_period_s"]["measured"].as_f64();
     let mut line = format!(
@@ -291,9 +290,7 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Writes `errors.csv`.
 fn write_errors_csv(path: &Path, run: &ChannelRun) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = crate::line_file::LineWriter::create(path)?;
     let mut line = String::with_capacity(256);
     writeln!(
         w,
@@ -320,8 +317,7 @@ fn write_errors_csv(path: &Path, run: &ChannelRun) -> Result<()> {
         }
         writeln!(w, "{line}")?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 fn triple(e: &ErrorState) -> Value {

@@ -298,8 +298,7 @@ pub fn run(args: Args) -> Result<()> {
         let json = summary_json(&c, (&args.nav, nav_format), (&args.truth, truth_format));
         let text = serde_json::to_string_pretty(&json).context("encoding compare.json")?;
         let path = dir.join("compare.json");
-        std::fs::write(&path, text + "\n")
-            .with_context(|| format!("writing {}", path.display()))?;
+        crate::line_file::write_whole(&path, text + "\n")?;
         write_errors_csv(&dir.join("errors.csv"), &c.errors)?;
         write_plots(dir, &c)?;
         println!(

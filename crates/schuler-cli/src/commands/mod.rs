@@ -16,6 +16,7 @@ pub mod vertical;
 /// `schuler nav`: a KF-GINS configuration (`--kf-gins-config`) runs as KF-GINS does
 /// ([`kf_gins::run`]), anything else as [`nav::run`].
 pub fn run_nav(args: nav::NavArgs) -> anyhow::Result<()> {
+    crate::interrupt::watch();
     match &args.kf_gins_config {
         Some(path) => kf_gins::run(
             path,

@@ -395,7 +395,7 @@ pub fn run(args: Args) -> Result<()> {
 }
 
 fn write_file(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    crate::line_file::write_whole(path, text)
 }
 
 /// The epoch of the table: 1 h after the start, or the last one of a shorter run.
@@ -409,9 +409,7 @@ fn table_epoch(c: &Comparison) -> usize {
 
 /// Writes `errors.csv`.
 fn write_errors_csv(path: &Path, c: &Comparison) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = crate::line_file::LineWriter::create(path)?;
     let mut line = String::from("t");
     for s in &c.systems {
         for q in [
@@ -437,8 +435,7 @@ fn write_errors_csv(path: &Path, c: &Comparison) -> Result<()> {
         }
         writeln!(w, "{line}")?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 /// Writes one plot per quantity. One system whose error peaks more than 20 times

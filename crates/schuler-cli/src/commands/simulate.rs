@@ -30,13 +30,12 @@
 
 use crate::drive::{imu_err_row, push_table_row};
 use crate::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
+use crate::line_file::LineFile;
 use crate::output::{push_nav_fields, put_imu_increments, put_nav_fields};
 use crate::text_block::{TextBlock, window};
 use anyhow::{Context, Result};
 use schuler::sim::receivers::GnssFix;
 use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -54,36 +53,9 @@ pub struct Args {
     pub seed: Option<u64>,
 }
 
-/// A buffered output file that remembers its path for error messages.
-struct Out {
-    w: BufWriter<File>,
-    path: PathBuf,
-}
-
-impl Out {
-    fn create(dir: &Path, name: &str) -> Result<Self> {
-        let path = dir.join(name);
-        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
-        Ok(Self {
-            w: BufWriter::with_capacity(1 << 16, f),
-            path,
-        })
-    }
-
-    /// Write `bytes`; an error names the file.
-    fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-        self.w
-            .write_all(bytes)
-            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", self.path.display())))
-    }
-
-    fn finish(mut self) -> Result<()> {
-        self.w
-            .flush()
-            .with_context(|| format!("cannot write {}", self.path.display()))
-    }
-}
-
+/// An output file: whole blocks of lines, cut back to the last whole line if a write
+/// fails; errors name the file.
+type Out = LineFile;
 /// Decimals of the true angular rate in `truth.csv` (1e-12 rad/s).
 const W_DECIMALS: usize = 12;
 /// Decimals of the true specific force in `truth.csv` (1e-10 m/s^2).
@@ -283,6 +255,9 @@ struct BlockText {
     gnss_csv: Vec<u8>,
     baro_csv: Vec<u8>,
     imu_err: Vec<u8>,
+    /// The block's IMU samples and the time of its last [s].
+    samples: u64,
+    last_t: f64,
 }
 
 impl BlockText {
@@ -306,6 +281,8 @@ impl BlockText {
         }
         // Room for the windows of every line: the block's text takes memory once.
         let lines = block.imu.len();
+        self.samples = lines as u64;
+        self.last_t = block.imu.last().map_or(f64::NAN, |e| e.truth.t);
         self.imu_txt.reserve(lines * IMU_WINDOW);
         self.imu_csv.reserve(lines * IMU_WINDOW);
         self.truth_nav.reserve(lines * (2 + NAV_WINDOW));
@@ -344,25 +321,24 @@ struct Files {
 impl Files {
     fn create(dir: &Path, gnss: bool, baro: bool) -> Result<Self> {
         let with_header = |name: &str, header: &str| -> Result<Out> {
-            let mut o = Out::create(dir, name)?;
-            writeln!(o.w, "{header}")
-                .with_context(|| format!("cannot write {}", o.path.display()))?;
+            let mut o = Out::create(dir.join(name))?;
+            o.append(format!("{header}\n").as_bytes())?;
             Ok(o)
         };
         Ok(Self {
-            imu_txt: Out::create(dir, "imu.txt")?,
+            imu_txt: Out::create(dir.join("imu.txt"))?,
             imu_csv: with_header(
                 "imu.csv",
                 "t,dtheta_x,dtheta_y,dtheta_z,dvel_x,dvel_y,dvel_z",
             )?,
-            truth_nav: Out::create(dir, "truth.nav")?,
+            truth_nav: Out::create(dir.join("truth.nav"))?,
             truth_csv: with_header(
                 "truth.csv",
                 "t,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,w_x,w_y,w_z,f_x,f_y,f_z",
             )?,
             gnss: if gnss {
                 Some((
-                    Out::create(dir, "gnss.txt")?,
+                    Out::create(dir.join("gnss.txt"))?,
                     with_header(
                         "gnss.csv",
                         "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier",
@@ -376,44 +352,24 @@ impl Files {
             } else {
                 None
             },
-            imu_err: Out::create(dir, "imu_err_truth.txt")?,
+            imu_err: Out::create(dir.join("imu_err_truth.txt"))?,
         })
     }
 
     /// Write a block's text to every file; an error names the file.
     fn write(&mut self, t: &BlockText) -> std::io::Result<()> {
-        self.imu_txt.write_all(t.imu_txt.as_bytes())?;
-        self.imu_csv.write_all(t.imu_csv.as_bytes())?;
-        self.truth_nav.write_all(t.truth_nav.as_bytes())?;
-        self.truth_csv.write_all(t.truth_csv.as_bytes())?;
+        self.imu_txt.append(t.imu_txt.as_bytes())?;
+        self.imu_csv.append(t.imu_csv.as_bytes())?;
+        self.truth_nav.append(t.truth_nav.as_bytes())?;
+        self.truth_csv.append(t.truth_csv.as_bytes())?;
         if let Some((txt, csv)) = self.gnss.as_mut() {
-            txt.write_all(&t.gnss_txt)?;
-            csv.write_all(&t.gnss_csv)?;
+            txt.append(&t.gnss_txt)?;
+            csv.append(&t.gnss_csv)?;
         }
         if let Some(b) = self.baro_csv.as_mut() {
-            b.write_all(&t.baro_csv)?;
+            b.append(&t.baro_csv)?;
         }
-        self.imu_err.write_all(&t.imu_err)?;
-        Ok(())
-    }
-
-    fn finish(self) -> Result<()> {
-        for o in [
-            self.imu_txt,
-            self.imu_csv,
-            self.truth_nav,
-            self.truth_csv,
-            self.imu_err,
-        ] {
-            o.finish()?;
-        }
-        if let Some((a, b)) = self.gnss {
-            a.finish()?;
-            b.finish()?;
-        }
-        if let Some(b) = self.baro_csv {
-            b.finish()?;
-        }
+        self.imu_err.append(&t.imu_err)?;
         Ok(())
     }
 }
@@ -439,24 +395,41 @@ pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
 pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::run::SimSummary> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut files = Files::create(dir, spec.gnss.is_some(), spec.baro.is_some())?;
+    let (mut samples, mut written_to) = (0u64, f64::NAN);
     let summary = simulate_with(
         spec,
         |block, text: &mut BlockText| text.format(block),
-        |text| files.write(text),
+        |text| {
+            files.write(text)?;
+            (samples, written_to) = (samples + text.samples, text.last_t);
+            // A signal stops the run after a whole block: every file ends there.
+            match crate::interrupt::requested() {
+                Some(_) => Err(std::io::Error::from(std::io::ErrorKind::Interrupted)),
+                None => Ok(()),
+            }
+        },
     );
-    // Flush what was written even when the simulation stopped early.
-    let flushed = files.finish();
+    // Every block written is in the files, whole, even when the simulation stopped
+    // early.
+    drop(files);
+    if let (Err(_), Some(i)) = (&summary, crate::interrupt::requested()) {
+        return Err(anyhow::Error::new(i).context(format!(
+            "stopped at t = {written_to} s: the files in {} hold the {samples} IMU samples up to \
+             there, with the GNSS, barometer and sensor-error lines up to the same time",
+            dir.display()
+        )));
+    }
     let summary = summary?;
-    flushed?;
     let resolved =
         toml::to_string(&spec.resolved()).context("cannot serialize the resolved scenario")?;
     let path = dir.join("scenario.resolved.toml");
-    std::fs::write(&path, resolved).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::line_file::write_whole(&path, resolved)?;
     Ok(summary)
 }
 
 /// `schuler simulate`.
 pub fn run(args: Args) -> Result<()> {
+    crate::interrupt::watch();
     let started = Instant::now();
     let mut spec = load_scenario(&args.config)?;
     if let Some(seed) = args.seed {

@@ -238,8 +238,7 @@ pub fn run(args: Args) -> Result<()> {
         ModeChoice::Aided => run_aided(&cfg, &args)?,
     };
     let text = serde_json::to_string_pretty(&summary).context("encoding summary.json")?;
-    std::fs::write(args.out.join("summary.json"), text + "\n")
-        .with_context(|| format!("writing {}", args.out.join("summary.json").display()))?;
+    crate::line_file::write_whole(&args.out.join("summary.json"), text + "\n")?;
     println!(
         "schuler vertical ({}): wrote {}",
         summary["mode"].as_str().unwrap_or("?"),
@@ -250,15 +249,12 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Writes `vertical.csv`.
 fn write_samples(path: &Path, samples: &[VerticalSample]) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = crate::line_file::LineWriter::create(path)?;
     writeln!(w, "t,dh,dvh,mode")?;
     for s in samples {
         writeln!(w, "{},{:e},{:e},{}", s.t, s.dh, s.dvh, s.mode.as_str())?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 fn eigen_json(l: &[nalgebra::Complex<f64>]) -> Value {
@@ -647,9 +643,7 @@ fn rms(xs: impl Iterator<Item = f64>) -> f64 {
 }
 
 fn write_kf(path: &Path, kf: &KalmanRun) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = crate::line_file::LineWriter::create(path)?;
     writeln!(w, "t,dh,dvh,mode,k1,k2,sigma_h")?;
     for s in &kf.samples {
         writeln!(
@@ -664,8 +658,7 @@ fn write_kf(path: &Path, kf: &KalmanRun) -> Result<()> {
             s.sigma_h
         )?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 fn write_reference(
@@ -674,9 +667,7 @@ fn write_reference(
     reference: &[Option<f64>],
     height: f64,
 ) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = crate::line_file::LineWriter::create(path)?;
     writeln!(w, "t,dh_ref")?;
     let mut line = String::new();
     for (k, r) in reference.iter().enumerate() {
@@ -687,8 +678,7 @@ fn write_reference(
         }
         writeln!(w, "{line}")?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 /// Prediction intervals [t0, t1) of a run, in plot time units.

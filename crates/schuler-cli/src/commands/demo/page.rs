@@ -46,15 +46,12 @@ pub(super) fn csv(
     rows: impl IntoIterator<Item = String>,
 ) -> Result<()> {
     let path = dir.join(name);
-    let file = std::fs::File::create(&path)
-        .with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut w = crate::line_file::LineWriter::create(&path)?;
     writeln!(w, "{header}")?;
     for r in rows {
         writeln!(w, "{r}")?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    w.finish()
 }
 
 /// A table of `rows` under `header`, also written as `name` in `dir` (the same
