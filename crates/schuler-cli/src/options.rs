@@ -184,6 +184,21 @@ impl GradeChoice {
     }
 }
 
+/// `value` [SI] of a flag or key `key` if it is in `domain` (a number of
+/// [`schuler::domain`]); else the error naming the key.
+pub fn in_domain(key: &str, domain: &schuler::domain::Domain, value: f64) -> Result<f64> {
+    domain.check(value).with_context(|| key.to_owned())
+}
+
+/// `Some(x)` [SI] of a flag or key `key` if `x` is in `domain`, else the error naming it.
+pub fn opt_in_domain(
+    key: &str,
+    domain: &schuler::domain::Domain,
+    value: Option<f64>,
+) -> Result<Option<f64>> {
+    value.map(|x| in_domain(key, domain, x)).transpose()
+}
+
 /// A rate flag [Hz], checked positive.
 pub fn rate(flag: &str, r: Option<f64>) -> Result<Option<f64>> {
     if let Some(r) = r

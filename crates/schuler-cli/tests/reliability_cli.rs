@@ -244,3 +244,259 @@ fn a_stream_without_line_ends_is_refused_by_every_reader() {
         );
     }
 }
+
+/// `schuler ARGS`, which must fail; its stderr.
+fn refused(args: &[&std::ffi::OsStr]) -> String {
+    let o = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(args)
+        .assert()
+        .failure();
+    String::from_utf8_lossy(&o.get_output().stderr).into_owned()
+}
+
+/// `text` with field `col` of data line `line` (0-based) replaced by `value`.
+fn with_field(text: &str, line: usize, col: usize, value: &str) -> String {
+    let mut out = String::new();
+    for (i, l) in text.lines().enumerate() {
+        let mut f: Vec<&str> = l.split_whitespace().collect();
+        if i == line {
+            f[col] = value;
+        }
+        out.push_str(&f.join(" "));
+        out.push('\n');
+    }
+    out
+}
+
+/// Aids, scenario values, model parameters and KF-GINS keys of 1e308 or 1e20 (issue
+/// "Reliability": NaN NIS, `simulate` writing inf, `channel`/`platform` running to
+/// inf, the YAML's `initgyrbias` named by session fields) are refused by name: file,
+/// line and field, or the key or flag.
+#[test]
+fn aids_and_parameters_outside_their_domain_are_refused_by_name() {
+    use std::ffi::OsStr;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let imu = corrupted(d, 0..0, "");
+    let data = common::test_data("drive9min");
+    let gnss_text = std::fs::read_to_string(data.join("GNSS.txt")).expect("gnss");
+    let write = |name: &str, text: &str| {
+        let p = d.join(name);
+        std::fs::write(&p, text).expect("write");
+        p
+    };
+    let gnss_bad = write("gnss_std.txt", &with_field(&gnss_text, 2, 4, "1e308"));
+    let baro = write("baro.txt", "t h\n1.0 245\n2.0 1e308\n");
+    let odometer = write("odometer.txt", "1.0 0\n2.0 1e308\n");
+    let heading = write("heading.txt", "1.0 10 1e308\n");
+    let nav = |extra: &[&OsStr]| {
+        let mut args: Vec<&OsStr> = ["nav", "--imu"].map(OsStr::new).to_vec();
+        args.push(imu.as_os_str());
+        args.extend(
+            [
+                "--init-pos",
+                "45.0712345678,7.6812345678,245",
+                "--init-att",
+                "0,0,10",
+            ]
+            .map(OsStr::new),
+        );
+        args.extend_from_slice(extra);
+        args.extend([OsStr::new("--out"), d.join("out").into_os_string().leak()]);
+        refused(&args)
+    };
+    let gnss = data.join("GNSS.txt");
+    let flag = |f: &'static str, p: &std::path::Path| -> [&OsStr; 2] {
+        [OsStr::new(f), p.as_os_str().to_os_string().leak()]
+    };
+    let cases = [
+        (
+            nav(&flag("--gnss", &gnss_bad)),
+            "gnss_std.txt:3: field std_n: position standard deviation 1e308 m is outside",
+        ),
+        (
+            nav(&[flag("--gnss", &gnss), flag("--baro", &baro)].concat()),
+            "baro.txt:3: field h: height 1e308 m is outside",
+        ),
+        (
+            nav(&[flag("--gnss", &gnss), flag("--odometer", &odometer)].concat()),
+            "odometer.txt:2: field speed: speed 1e308 m/s is outside",
+        ),
+        (
+            nav(&[flag("--gnss", &gnss), flag("--dual-antenna", &heading)].concat()),
+            "heading.txt:1: field std_heading: angle standard deviation 1e308 deg is outside",
+        ),
+        (
+            nav(&flag("--truth", &gnss)),
+            "--truth is used by the filter's report, and this run has no aid",
+        ),
+    ];
+    for (stderr, want) in cases {
+        assert!(stderr.contains(want), "{want:?} not in {stderr}");
+    }
+
+    let example = |name: &str| {
+        std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../examples")
+                .join(name),
+        )
+        .expect("example")
+    };
+    let scenario = write(
+        "drive.toml",
+        &example("drive.toml").replace(
+            "velocity_std = [\"0.05 m/s\"",
+            "velocity_std = [\"1e308 m/s\"",
+        ),
+    );
+    let platform = write(
+        "platform.toml",
+        &example("platform.toml").replace(
+            "gyro_drift = [\"0.01 deg/h\"",
+            "gyro_drift = [\"1e20 rad/s\"",
+        ),
+    );
+    let yaml_text = |key: &str, value: &str| {
+        format!(
+            "imupath: \"{}\"\ngnsspath: \"{}\"\noutputpath: \"{}\"\n\
+             imudatalen: 7\nimudatarate: 100\nstarttime: 1.0\nendtime: -1\n\
+             initpos: [ 45.07, 7.68, 245.0 ]\ninitvel: [ 0, 0, 0 ]\ninitatt: [ 0, 0, 10 ]\n\
+             initgyrbias: [ 0, 0, 0 ]\ninitaccbias: [ 0, 0, 0 ]\n\
+             initgyrscale: [ 0, 0, 0 ]\ninitaccscale: [ 0, 0, 0 ]\n\
+             initposstd: [ 0.1, 0.1, 0.1 ]\ninitvelstd: [ 0.01, 0.01, 0.01 ]\n\
+             initattstd: [ 0.01, 0.01, 0.1 ]\n\
+             imunoise:\n  arw: [0.1, 0.1, 0.1]\n  vrw: [0.08, 0.08, 0.08]\n\
+             \x20 gbstd: [0.2, 0.2, 0.2]\n  abstd: [20.0, 20.0, 20.0]\n\
+             \x20 gsstd: [1000.0, 1000.0, 1000.0]\n  asstd: [1000.0, 1000.0, 1000.0]\n\
+             \x20 corrtime: 0.5\nantlever: [ 0.0, 0.0, 0.0 ]\n",
+            imu.display(),
+            gnss.display(),
+            d.join("kf").display()
+        )
+        .replace(
+            &format!("{key}: [ 0, 0, 0 ]"),
+            &format!("{key}: [ {value}, 0, 0 ]"),
+        )
+        .replace(
+            "initpos: [ 45.07, 7.68,",
+            &format!(
+                "initpos: [ 45.07, {},",
+                if key == "initpos" { value } else { "7.68" }
+            ),
+        )
+    };
+    let yaml = |key: &str, value: &str| write(&format!("{key}.yaml"), &yaml_text(key, value));
+    let os = |s: &'static str| OsStr::new(s);
+    let cases = [
+        (
+            refused(&[
+                os("simulate"),
+                os("--config"),
+                scenario.as_os_str(),
+                os("--out"),
+                d.join("sim").into_os_string().leak(),
+            ]),
+            "gnss.velocity_std[0]: velocity standard deviation 1e308 m/s is outside",
+        ),
+        (
+            refused(&[
+                os("platform"),
+                os("--config"),
+                platform.as_os_str(),
+                os("--out"),
+                d.join("p").into_os_string().leak(),
+            ]),
+            "errors.gyro_drift[0]: angular rate 5.72957795130823",
+        ),
+        (
+            refused(&[
+                os("channel"),
+                os("--gyro-drift=1e20rad/s"),
+                os("--out"),
+                d.as_os_str(),
+            ]),
+            "--gyro-drift: angular rate",
+        ),
+        (
+            refused(&[
+                os("channel"),
+                os("--speed=1e9m/s"),
+                os("--out"),
+                d.as_os_str(),
+            ]),
+            "--speed: speed 1e9 m/s is outside",
+        ),
+        (
+            refused(&[
+                os("channel"),
+                os("--earth-rate=1e9deg/h"),
+                os("--out"),
+                d.as_os_str(),
+            ]),
+            "--earth-rate: angular rate",
+        ),
+        (
+            refused(&[
+                os("nav"),
+                os("--kf-gins-config"),
+                yaml("initgyrbias", "1e20").as_os_str(),
+            ]),
+            "initgyrbias[0]: angular rate",
+        ),
+        (
+            refused(&[
+                os("nav"),
+                os("--kf-gins-config"),
+                yaml("initpos", "400").as_os_str(),
+            ]),
+            "initpos[1]: longitude 400 deg is outside",
+        ),
+    ];
+    for (stderr, want) in cases {
+        assert!(stderr.contains(want), "{want:?} not in {stderr}");
+    }
+}
+
+/// A navigation result with a velocity of 1.7e308 m/s (the issue's reproducer gave
+/// "RMS inf"): `compare` prints finite statistics, the largest error among them.
+#[test]
+fn compare_statistics_stay_finite_for_huge_errors() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let truth = String::from_utf8(common::unxz(
+        &common::test_data("drive9min").join("truth.nav.xz"),
+    ))
+    .expect("utf-8");
+    let truth_path = dir.path().join("truth.nav");
+    std::fs::write(&truth_path, &truth).expect("write");
+    let nav_path = dir.path().join("nav.txt");
+    std::fs::write(&nav_path, with_field(&truth, 100, 5, "1.7e308")).expect("write");
+    let out = dir.path().join("cmp");
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .arg("compare")
+        .arg(&nav_path)
+        .arg(&truth_path)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("compare.json")).expect("compare.json"),
+    )
+    .expect("json");
+    // One error e among n epochs, the rest 0: RMS e/sqrt(n), mean e/n (a non-finite
+    // number would be written as null and fail here).
+    let v = &json["statistics"]["v_north_mps"];
+    let (e, n) = (
+        1.7e308,
+        json["epochs"]["matched"].as_f64().expect("matched"),
+    );
+    let rms = v["rms"].as_f64().expect("finite rms");
+    let mean = v["mean"].as_f64().expect("finite mean");
+    // The scaled sums are exact but for a few roundings.
+    assert!((rms / (e / n.sqrt()) - 1.0).abs() < 1e-14, "{rms}");
+    assert!((mean / (e / n) - 1.0).abs() < 1e-14, "{mean}");
+    assert_eq!(v["max"].as_f64(), Some(e));
+}

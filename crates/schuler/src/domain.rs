@@ -235,6 +235,35 @@ pub const LEVER_ARM: Domain = Domain {
     why: "longer than any vehicle",
 };
 
+/// Longitude [rad] after [`wrap_longitude`]: (-180, 180] deg.
+pub const LONGITUDE_WRAPPED: Domain = Domain {
+    min: -180.0 * DEG,
+    max: 180.0 * DEG,
+    why: "east longitude after wrapping, -180 to 180",
+    ..LONGITUDE
+};
+
+/// A heading or yaw reading [rad], in either convention (-180..180 or 0..360 deg) and
+/// a turn beyond for an unwrapped one; anything larger is not an angle read in degrees.
+pub const HEADING: Domain = Domain {
+    quantity: "heading",
+    min: -360.0 * DEG,
+    max: 720.0 * DEG,
+    unit: "deg",
+    scale: DEG,
+    why: "a heading in degrees, -360 to 720",
+};
+
+/// A pitch angle [rad].
+pub const PITCH: Domain = Domain {
+    quantity: "pitch",
+    min: -90.0 * DEG,
+    max: 90.0 * DEG,
+    unit: "deg",
+    scale: DEG,
+    why: "a pitch angle",
+};
+
 /// Longitude [rad] checked by [`LONGITUDE`] and wrapped into (-π, π].
 pub fn wrap_longitude(lon: f64) -> Result<f64, DomainError> {
     let lon = LONGITUDE.check(lon)?;

@@ -456,6 +456,21 @@ impl AidingOptions {
         }
         vehicle::check_dependencies(self)?;
         if !(self.any() || given.any()) {
+            // The truth serves the filter's report and outage test: a free-inertial
+            // run has neither, so it is refused rather than ignored.
+            for (given, flag) in [
+                (self.truth.is_some(), "--truth"),
+                (self.sensor_truth.is_some(), "--sensor-truth"),
+                (self.outage_test.is_some(), "--outage-test"),
+            ] {
+                if given {
+                    bail!(
+                        "{flag} is used by the filter's report, and this run has no aid \
+                         (--gnss, --baro, --odometer, ...); compare a free-inertial result \
+                         with `schuler compare NAV TRUTH`"
+                    );
+                }
+            }
             return Ok(None);
         }
         let mut fixes = self.fixes(given.fixes)?;

@@ -9,7 +9,8 @@
 //! figures 4-15. Every value with a unit goes through `schuler::units`.
 
 use crate::options::{
-    SphereArgs, acceleration, angle, angular_rate, is_positive, length, ratio, time, velocity,
+    SphereArgs, acceleration, angle, angular_rate, in_domain, is_positive, length, opt_in_domain,
+    ratio, time, velocity,
 };
 use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
@@ -19,6 +20,7 @@ use schuler::channel::linear::ErrorState;
 use schuler::channel::models::{Alignment, SensorErrors, System};
 use schuler::channel::profile::{BodyAngleProfile, SpeedProfile};
 use schuler::channel::run::{ChannelConfig, ChannelRun, simulate};
+use schuler::domain::Domain;
 use schuler::units::{ARCSEC, DEG};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
@@ -159,8 +161,57 @@ pub struct Args {
     pub out: PathBuf,
 }
 
+/// A position error [m] of the channel: within the Earth's quadrant.
+const POSITION_ERROR: Domain = Domain {
+    quantity: "position error",
+    min: -1e7,
+    max: 1e7,
+    unit: "m",
+    scale: 1.0,
+    why: "at most the Earth's quadrant",
+};
+
+/// Every physical flag in its domain ([`schuler::domain`]): a drift of 1e20 rad/s or
+/// an Earth turning at 1e9 deg/h has no channel to model.
+fn check_domains(args: &Args) -> Result<()> {
+    use schuler::domain as d;
+    let flags: [(&str, &Domain, Option<f64>); 11] = [
+        (
+            "--accel-bias",
+            &d::SPECIFIC_FORCE_COMPONENT,
+            args.accel_bias,
+        ),
+        (
+            "--accel-bias-p1",
+            &d::SPECIFIC_FORCE_COMPONENT,
+            args.accel_bias_p1,
+        ),
+        (
+            "--accel-bias-p2",
+            &d::SPECIFIC_FORCE_COMPONENT,
+            args.accel_bias_p2,
+        ),
+        ("--gyro-drift", &d::ANGULAR_RATE_COMPONENT, args.gyro_drift),
+        ("--gyro-scale", &d::SCALE_FACTOR, args.gyro_scale),
+        ("--init-tilt", &d::PITCH, args.init_tilt),
+        ("--init-vel-error", &d::SPEED, args.init_vel_error),
+        ("--init-pos-error", &POSITION_ERROR, args.init_pos_error),
+        ("--earth-rate", &d::ANGULAR_RATE_COMPONENT, args.earth_rate),
+        ("--rotate", &d::ANGULAR_RATE_COMPONENT, args.rotate),
+        ("--speed", &d::SPEED, args.speed),
+    ];
+    for (flag, domain, value) in flags {
+        opt_in_domain(flag, domain, value)?;
+    }
+    for a in &args.accelerate {
+        in_domain("--accelerate", &d::SPEED, a.delta_v)?;
+    }
+    Ok(())
+}
+
 /// Builds the library scenario from the flags, naming the flag on any inconsistency.
 pub fn config(args: &Args) -> Result<ChannelConfig> {
+    check_domains(args)?;
     let system = match args.system {
         SystemChoice::Ins => System::Ins,
         SystemChoice::Sins => System::Sins,

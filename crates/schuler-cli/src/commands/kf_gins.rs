@@ -135,13 +135,7 @@ fn read_yaml(path: &Path) -> Result<KfGinsYaml> {
             y.imudatarate
         );
     }
-    if !(-90.0..=90.0).contains(&y.initpos[0]) {
-        bail!(
-            "{}: initpos: latitude {} is outside [-90, 90]",
-            path.display(),
-            y.initpos[0]
-        );
-    }
+    check_domains(path, &y)?;
     let n = &y.imunoise;
     if !(n.corrtime.is_finite() && n.corrtime > 0.0) {
         bail!(
@@ -151,6 +145,79 @@ fn read_yaml(path: &Path) -> Result<KfGinsYaml> {
         );
     }
     Ok(y)
+}
+
+/// Every initial value of the configuration in its physical domain
+/// ([`schuler::domain`], in KF-GINS's units); the error names the key and the element
+/// (`initpos[1]: longitude 400 deg is outside ...`).
+fn check_domains(path: &Path, y: &KfGinsYaml) -> Result<()> {
+    use schuler::domain::{self as d, Domain};
+    use schuler::units::DEG;
+    const ROLL: Domain = Domain {
+        quantity: "roll",
+        ..d::HEADING
+    };
+    let same = |domain: &'static Domain, unit: f64| -> Axes { [(domain, unit); 3] };
+    let optional = |v: Option<[f64; 3]>| v.unwrap_or([1.0; 3]);
+    // Each key: its values, and each value's domain and KF-GINS unit [SI].
+    type Axes = [(&'static Domain, f64); 3];
+    let table: [(&str, [f64; 3], Axes); 15] = [
+        (
+            "initpos",
+            y.initpos,
+            [(&d::LATITUDE, DEG), (&d::LONGITUDE, DEG), (&d::HEIGHT, 1.0)],
+        ),
+        ("initvel", y.initvel, same(&d::SPEED, 1.0)),
+        (
+            "initatt",
+            y.initatt,
+            [(&ROLL, DEG), (&d::PITCH, DEG), (&d::HEADING, DEG)],
+        ),
+        (
+            "initgyrbias",
+            y.initgyrbias,
+            same(&d::ANGULAR_RATE_COMPONENT, DEG_PER_H),
+        ),
+        (
+            "initaccbias",
+            y.initaccbias,
+            same(&d::SPECIFIC_FORCE_COMPONENT, MGAL),
+        ),
+        ("initgyrscale", y.initgyrscale, same(&d::SCALE_FACTOR, PPM)),
+        ("initaccscale", y.initaccscale, same(&d::SCALE_FACTOR, PPM)),
+        ("initposstd", y.initposstd, same(&d::POSITION_STD, 1.0)),
+        ("initvelstd", y.initvelstd, same(&d::VELOCITY_STD, 1.0)),
+        ("initattstd", y.initattstd, same(&d::ANGLE_STD, DEG)),
+        (
+            "initbgstd",
+            optional(y.initbgstd),
+            same(&d::ANGULAR_RATE, DEG_PER_H),
+        ),
+        (
+            "initbastd",
+            optional(y.initbastd),
+            same(&d::SPECIFIC_FORCE, MGAL),
+        ),
+        (
+            "initsgstd",
+            optional(y.initsgstd),
+            same(&d::SCALE_FACTOR, PPM),
+        ),
+        (
+            "initsastd",
+            optional(y.initsastd),
+            same(&d::SCALE_FACTOR, PPM),
+        ),
+        ("antlever", y.antlever, same(&d::LEVER_ARM, 1.0)),
+    ];
+    for (key, values, domains) in &table {
+        for (k, (v, (domain, unit))) in values.iter().zip(domains).enumerate() {
+            if let Err(e) = domain.check(v * unit) {
+                bail!("{}: {key}[{k}]: {e}", path.display());
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The IMU noise model of `imunoise`, in SI units (Gauss–Markov biases and scale
@@ -250,7 +317,11 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
             check_layout: true,
             ..ImuReadOptions::default()
         },
-        init_pos: Geodetic::from_degrees(y.initpos[0], y.initpos[1], y.initpos[2]),
+        init_pos: Geodetic {
+            // 0-360 deg wrapped, as everywhere (checked by `check_domains`).
+            lon: schuler::domain::wrap_longitude(y.initpos[1].to_radians())?,
+            ..Geodetic::from_degrees(y.initpos[0], 0.0, y.initpos[2])
+        },
         init_vel: Vector3::from(y.initvel),
         init_att: Euler::from_degrees(y.initatt[0], y.initatt[1], y.initatt[2]),
         output_rate: None,

@@ -14,6 +14,7 @@
 //! `tilt_east.svg`, `heading.svg`), the table of errors at 1 h (or at the end of a
 //! shorter run) as `table.csv` and `table.md`, and `summary.json`.
 
+use crate::options::in_domain;
 use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use nalgebra::{Vector3, Vector6};
@@ -124,6 +125,20 @@ fn vec3(q: &Option<[Quantity; 3]>, key: &str, dim: Dimension) -> Result<Vector3<
         for i in 0..3 {
             v[i] = si(&q[i], &format!("{key}[{i}]"), dim)?;
         }
+    }
+    Ok(v)
+}
+
+/// [`vec3`] with each axis in `domain`.
+fn vec3_in(
+    q: &Option<[Quantity; 3]>,
+    key: &str,
+    dim: Dimension,
+    domain: &schuler::domain::Domain,
+) -> Result<Vector3<f64>> {
+    let v = vec3(q, key, dim)?;
+    for (i, x) in v.iter().enumerate() {
+        in_domain(&format!("{key}[{i}]"), domain, *x)?;
     }
     Ok(v)
 }
@@ -244,15 +259,17 @@ fn parse(spec: ConfigSpec) -> Result<Config> {
         10.0,
     )?;
     let errors = InstrumentErrors {
-        accel_bias: vec3(
+        accel_bias: vec3_in(
             &spec.errors.accel_bias,
             "errors.accel_bias",
             Dimension::Acceleration,
+            &schuler::domain::SPECIFIC_FORCE_COMPONENT,
         )?,
-        gyro_drift: vec3(
+        gyro_drift: vec3_in(
             &spec.errors.gyro_drift,
             "errors.gyro_drift",
             Dimension::AngularRate,
+            &schuler::domain::ANGULAR_RATE_COMPONENT,
         )?,
     };
     let (array, gyro_free_biases) = gyro_free(&spec.gyro_free, errors.accel_bias)?;

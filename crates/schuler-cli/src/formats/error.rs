@@ -85,6 +85,26 @@ impl fmt::Display for InputError {
     }
 }
 
+/// `value` (in `domain`'s display unit) in SI if it is within `domain`; else an
+/// [`InputErrorKind::OutOfDomain`] error naming `path`, `line` and `field`.
+pub fn in_domain(
+    path: &Path,
+    line: u64,
+    field: &str,
+    domain: &schuler::domain::Domain,
+    value: f64,
+) -> Result<f64, InputError> {
+    domain.check_in_unit(value).map_err(|e| {
+        InputError::new(
+            InputErrorKind::OutOfDomain,
+            path,
+            line,
+            Some(field),
+            e.to_string(),
+        )
+    })
+}
+
 /// A field's text for an error message: lossy UTF-8 (invalid bytes become U+FFFD), at
 /// most 40 characters, quoted, control characters escaped (`"abc"`, `"a\u{1}"`).
 pub(crate) fn quote_field(bytes: &[u8]) -> String {

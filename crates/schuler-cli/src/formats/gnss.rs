@@ -68,7 +68,7 @@
 //! # Barometer logs ([`read_baro`], `schuler nav --baro`)
 //! `baro.csv` as `schuler simulate` writes it (`t,h_m,outlier`) or headerless `t h`.
 
-use super::error::{InputError, InputErrorKind};
+use super::error::{InputError, InputErrorKind, in_domain};
 use super::lines::{Delimiter, data_lines, fields, read_lines_whole};
 use nalgebra::Vector3;
 use schuler::domain;
@@ -659,6 +659,18 @@ fn gnss_record(
         Some(s) => Vector3::new(s[0], s[1], s[2]),
         None => default_std(path, n, std_name, std)?,
     };
+    // The standard deviations and the velocity, named as the text layout does.
+    for (k, x) in pos_std.iter().enumerate() {
+        in_domain(path, n, POS_FIELDS[4 + k], &domain::POSITION_STD, *x)?;
+    }
+    for (k, x) in v.iter().enumerate().skip(7) {
+        let d = if k < 10 {
+            &domain::SPEED
+        } else {
+            &domain::VELOCITY_STD
+        };
+        in_domain(path, n, POS_FIELDS[k], d, *x)?;
+    }
     let fix = GnssFix {
         t: v[0],
         pos,
@@ -966,6 +978,7 @@ pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
         }
         let t = parse_field(path, n, "time", f[tc], "")?;
         let h = parse_field(path, n, "h", f[hc], "")?;
+        let h = in_domain(path, n, "h", &domain::HEIGHT, h)?;
         check_time(path, n, "time", t, out.last().map(|p| p.0))?;
         out.push((t, h));
     }

@@ -8,8 +8,9 @@
 //! - dual-antenna GNSS (`--dual-antenna`): `t heading std [pitch pitch_std]` [s, deg],
 //!   the baseline's heading from true north (clockwise) and optionally its pitch.
 
-use super::error::{InputError, InputErrorKind};
+use super::error::{InputError, InputErrorKind, in_domain};
 use super::gnss::numeric_rows;
+use schuler::domain;
 use schuler::filter::HeadingReading;
 use std::path::Path;
 
@@ -47,22 +48,29 @@ pub fn read_rest_intervals(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
 /// Read odometer speeds `(t, speed)`.
 pub fn read_odometer(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
     let rows = numeric_rows(path, &["time", "speed"], &[2], true)?;
-    Ok(rows.into_iter().map(|(_, v)| (v[0], v[1])).collect())
+    rows.into_iter()
+        .map(|(n, v)| Ok((v[0], in_domain(path, n, "speed", &domain::SPEED, v[1])?)))
+        .collect()
 }
 
 /// Read dual-antenna headings (3 or 5 columns), angles converted to radians.
 pub fn read_heading(path: &Path) -> Result<Vec<HeadingReading>, InputError> {
     let names = ["time", "heading", "std_heading", "pitch", "std_pitch"];
     let rows = numeric_rows(path, &names, &[3, 5], true)?;
-    Ok(rows
-        .into_iter()
-        .map(|(_, v)| HeadingReading {
-            t: v[0],
-            heading: schuler::rotation::wrap_pi(v[1].to_radians()),
-            heading_std: v[2].to_radians(),
-            pitch: (v.len() == 5).then(|| (v[3].to_radians(), v[4].to_radians())),
+    rows.into_iter()
+        .map(|(n, v)| {
+            let angle = |k: usize, d: &domain::Domain| in_domain(path, n, names[k], d, v[k]);
+            Ok(HeadingReading {
+                t: v[0],
+                heading: schuler::rotation::wrap_pi(angle(1, &domain::HEADING)?),
+                heading_std: angle(2, &domain::ANGLE_STD)?,
+                pitch: match v.len() {
+                    5 => Some((angle(3, &domain::PITCH)?, angle(4, &domain::ANGLE_STD)?)),
+                    _ => None,
+                },
+            })
         })
-        .collect())
+        .collect()
 }
 
 #[cfg(test)]

@@ -54,14 +54,34 @@ impl Summary {
         }
         let mut abs: Vec<f64> = e.iter().map(|x| x.abs()).collect();
         abs.sort_unstable_by(f64::total_cmp);
+        let (mut rms, mut mean) = ((sum2 / n).sqrt(), sum / n);
+        if !(rms.is_finite() && mean.is_finite()) && max_abs.is_finite() {
+            // Squares (or sums) of errors beyond 1e154 overflow: scaled by the largest,
+            // the same statistics stay finite (used only then, so that ordinary
+            // errors keep the bits of the plain sums).
+            (rms, mean) = scaled_rms_mean(e, max_abs);
+        }
         Some(Summary {
-            rms: (sum2 / n).sqrt(),
+            rms,
             max_abs,
             t_max_sow: t_max,
             p95_abs: percentile_sorted(&abs, 95.0)?,
-            mean: sum / n,
+            mean,
         })
     }
+}
+
+/// Root mean square and mean of `e` as `m sqrt(Σ(x/m)²/n)` and `m Σ(x/m)/n`, with
+/// `m` the largest `|x|`: finite for any finite errors.
+fn scaled_rms_mean(e: &[f64], m: f64) -> (f64, f64) {
+    if m == 0.0 {
+        return (0.0, 0.0);
+    }
+    let n = e.len() as f64;
+    let (s, s2) = e
+        .iter()
+        .fold((0.0, 0.0), |(s, s2), x| (s + x / m, s2 + (x / m) * (x / m)));
+    (m * (s2 / n).sqrt(), m * (s / n))
 }
 
 /// One error quantity of the table: its name, unit, and value for an epoch.
@@ -176,7 +196,12 @@ pub fn statistics(errors: &[EpochErrors], outages: &[(f64, f64)]) -> Option<Stat
     let with: Vec<&OutageMax> = per_outage.iter().filter(|o| o.epochs > 0).collect();
     let outage_rms = (!with.is_empty()).then(|| {
         let rms = |f: fn(&OutageMax) -> f64| {
-            (with.iter().map(|o| f(o).powi(2)).sum::<f64>() / with.len() as f64).sqrt()
+            let plain = (with.iter().map(|o| f(o).powi(2)).sum::<f64>() / with.len() as f64).sqrt();
+            if plain.is_finite() {
+                return plain;
+            }
+            let xs: Vec<f64> = with.iter().map(|o| f(o)).collect();
+            scaled_rms_mean(&xs, xs.iter().fold(0.0, |m: f64, x| m.max(x.abs()))).0
         };
         OutageMax {
             from_sow: with[0].from_sow,
@@ -273,4 +298,25 @@ pub fn compare(
         matching,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn huge_errors_give_finite_statistics() {
+        // rms of (m, 0, -m) is m sqrt(2/3), mean 0: the plain sum of squares is inf.
+        let m = 1.5e308;
+        let s = Summary::of(&[0.0, 1.0, 2.0], &[m, 0.0, -m]).expect("values");
+        assert!(s.rms.is_finite() && s.mean.is_finite());
+        // Scaled by m, every step is exact to an ulp or two.
+        assert!((s.rms / (m * (2.0f64 / 3.0).sqrt()) - 1.0).abs() < 4.0 * f64::EPSILON);
+        assert_eq!(s.mean, 0.0);
+        assert_eq!(s.max_abs, m);
+        // Ordinary errors keep the plain sums' bits.
+        let s = Summary::of(&[0.0, 1.0], &[3.0, 4.0]).expect("values");
+        assert_eq!(s.rms, (25.0f64 / 2.0).sqrt());
+        assert_eq!(s.mean, 3.5);
+    }
 }

@@ -8,6 +8,7 @@
 //! that began before it. Late aids are reported, never applied and never silently
 //! dropped; [`super::SessionConfig::reorder_window`] sets how late an aid may be.
 
+use crate::domain::{self, Domain, DomainError};
 use crate::filter::measurement::Kind;
 use crate::filter::{GnssFix, HeadingReading};
 use std::collections::VecDeque;
@@ -64,31 +65,43 @@ impl Aid {
         }
     }
 
-    /// Whether every number it carries is finite (and a rest ends after it starts).
-    pub fn is_finite(&self) -> bool {
+    /// Whether its times are finite (and a rest ends after it starts).
+    pub fn times_valid(&self) -> bool {
         match self {
-            Aid::Gnss(f) => {
-                f.t.is_finite()
-                    && f.pos.lat.is_finite()
-                    && f.pos.lon.is_finite()
-                    && f.pos.h.is_finite()
-                    && f.pos_std.iter().all(|x| x.is_finite() && *x > 0.0)
-                    && f.vel.is_none_or(|(v, s)| {
-                        v.iter().all(|x| x.is_finite())
-                            && s.iter().all(|x| x.is_finite() && *x > 0.0)
-                    })
-            }
-            Aid::Baro { t, h } => t.is_finite() && h.is_finite(),
-            Aid::Odometer { t, speed } => t.is_finite() && speed.is_finite(),
-            Aid::Heading(r) => {
-                r.t.is_finite()
-                    && r.heading.is_finite()
-                    && r.heading_std.is_finite()
-                    && r.heading_std > 0.0
-                    && r.pitch
-                        .is_none_or(|(p, s)| p.is_finite() && s.is_finite() && s > 0.0)
-            }
             Aid::Rest { t0, t1 } => t0.is_finite() && t1.is_finite() && t1 >= t0,
+            _ => self.t().is_finite(),
+        }
+    }
+
+    /// The first value outside its physical domain ([`crate::domain`]): the field's
+    /// name and why. A standard deviation of 1e308 or a height of 1e12 m is as wrong
+    /// as a NaN: its variance overflows and the innovation test turns into NaN.
+    pub fn out_of_domain(&self) -> Option<(&'static str, DomainError)> {
+        let each = |name, d: &Domain, xs: &[f64]| {
+            xs.iter().find_map(|&x| d.check(x).err().map(|e| (name, e)))
+        };
+        match self {
+            Aid::Gnss(f) => each("lat", &domain::LATITUDE, &[f.pos.lat])
+                .or_else(|| each("lon", &domain::LONGITUDE_WRAPPED, &[f.pos.lon]))
+                .or_else(|| each("h", &domain::HEIGHT, &[f.pos.h]))
+                .or_else(|| each("pos_std", &domain::POSITION_STD, f.pos_std.as_slice()))
+                .or_else(|| {
+                    f.vel.and_then(|(v, s)| {
+                        each("vel", &domain::SPEED, v.as_slice())
+                            .or_else(|| each("vel_std", &domain::VELOCITY_STD, s.as_slice()))
+                    })
+                }),
+            Aid::Baro { h, .. } => each("h", &domain::HEIGHT, &[*h]),
+            Aid::Odometer { speed, .. } => each("speed", &domain::SPEED, &[*speed]),
+            Aid::Heading(r) => each("heading", &domain::HEADING, &[r.heading])
+                .or_else(|| each("heading_std", &domain::ANGLE_STD, &[r.heading_std]))
+                .or_else(|| {
+                    r.pitch.and_then(|(p, s)| {
+                        each("pitch", &domain::PITCH, &[p])
+                            .or_else(|| each("pitch_std", &domain::ANGLE_STD, &[s]))
+                    })
+                }),
+            Aid::Rest { .. } => None,
         }
     }
 }
@@ -141,6 +154,49 @@ pub(crate) fn is_late(aid: &Aid, t_done: f64, dt: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_beyond_their_domain_are_named() {
+        use crate::earth::Geodetic;
+        use nalgebra::Vector3;
+        let fix = GnssFix {
+            t: 1.0,
+            pos: Geodetic::from_degrees(45.0, 7.0, 100.0),
+            pos_std: Vector3::new(0.5, 0.5, 1.0),
+            vel: Some((Vector3::new(1.0, 2.0, 0.0), Vector3::repeat(0.1))),
+        };
+        assert_eq!(Aid::Gnss(fix).out_of_domain(), None);
+        let field = |a: Aid| a.out_of_domain().map(|(f, _)| f);
+        let huge = |v: &mut f64| *v = 1e308;
+        let mut f = fix;
+        huge(&mut f.pos_std.y);
+        assert_eq!(field(Aid::Gnss(f)), Some("pos_std"));
+        let mut f = fix;
+        huge(&mut f.pos.h);
+        assert_eq!(field(Aid::Gnss(f)), Some("h"));
+        let mut f = fix;
+        f.vel = Some((Vector3::new(0.0, 0.0, 1e5), Vector3::repeat(0.1)));
+        assert_eq!(field(Aid::Gnss(f)), Some("vel"));
+        assert_eq!(field(Aid::Baro { t: 1.0, h: 1e12 }), Some("h"));
+        assert_eq!(
+            field(Aid::Odometer {
+                t: 1.0,
+                speed: -1e308
+            }),
+            Some("speed")
+        );
+        let r = HeadingReading {
+            t: 1.0,
+            heading: 0.1,
+            heading_std: 1e308,
+            pitch: None,
+        };
+        assert_eq!(field(Aid::Heading(r)), Some("heading_std"));
+        // A zero standard deviation is as impossible as a huge one.
+        let mut f = fix;
+        f.pos_std.x = 0.0;
+        assert_eq!(field(Aid::Gnss(f)), Some("pos_std"));
+    }
 
     #[test]
     fn insertion_keeps_time_order_and_arrival_order_among_equal_times() {

@@ -81,13 +81,25 @@ pub enum SessionError {
         /// Its interval [s].
         dt: f64,
     },
-    /// An aid with a number that is not finite (or a standard deviation not positive).
-    #[error("{kind} at t = {t}: a value is not finite or a standard deviation is not positive")]
+    /// An aid whose time is not finite (or a rest that ends before it starts).
+    #[error("{kind} at t = {t}: its time is not finite or its interval ends before it starts")]
     AidNotFinite {
         /// Its time [s].
         t: f64,
         /// What it was.
         kind: Kind,
+    },
+    /// An aid with a value outside its physical domain ([`crate::domain`]).
+    #[error("{kind} at t = {t}: field {field}: {error}")]
+    AidOutOfDomain {
+        /// Its time [s].
+        t: f64,
+        /// What it was.
+        kind: Kind,
+        /// The field (`lat`, `pos_std`, `speed`, ...).
+        field: &'static str,
+        /// The value and its domain.
+        error: crate::domain::DomainError,
     },
     /// No IMU sample was pushed.
     #[error("no IMU sample was pushed: nothing to navigate")]
@@ -311,10 +323,18 @@ impl<E: EarthModel> Session<E> {
 
     /// Push an aid (in arrival order; see [`aid`] for when it is late).
     pub fn push(&mut self, aid: Aid) -> Result<(), SessionError> {
-        if !aid.is_finite() {
+        if !aid.times_valid() {
             return Err(SessionError::AidNotFinite {
                 t: aid.t(),
                 kind: aid.kind(),
+            });
+        }
+        if let Some((field, error)) = aid.out_of_domain() {
+            return Err(SessionError::AidOutOfDomain {
+                t: aid.t(),
+                kind: aid.kind(),
+                field,
+                error,
             });
         }
         if let Some((t_done, dt)) = self.run.done

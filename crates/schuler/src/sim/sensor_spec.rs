@@ -21,6 +21,7 @@
 
 use super::receivers::{BaroModel, GnssModel, Interval, Outlier};
 use super::scenario::{Quantity, ScenarioError};
+use crate::domain::{self, Domain};
 use crate::imu::model::{ImuModel, TriadModel, VibrationLine};
 use crate::units::Dimension;
 use nalgebra::{Matrix3, Vector3};
@@ -419,6 +420,49 @@ fn vec3(q: &[Quantity; 3], key: &str, dim: Dimension) -> Result<Vector3<f64>, Sc
     Axes::Each(q.clone()).si(key, dim)
 }
 
+/// A value of the scenario in `domain` (its SI value), or an error naming `key`.
+fn within(domain: &Domain, key: &str, v: f64) -> Result<f64, ScenarioError> {
+    domain.check(v).map_err(|e| ScenarioError::Value {
+        key: key.into(),
+        message: e.to_string(),
+    })
+}
+
+/// [`vec3`] with each axis in `domain`.
+fn vec3_in(
+    q: &[Quantity; 3],
+    key: &str,
+    dim: Dimension,
+    domain: &Domain,
+) -> Result<Vector3<f64>, ScenarioError> {
+    let v = vec3(q, key, dim)?;
+    for (i, x) in v.iter().enumerate() {
+        within(domain, &format!("{key}[{i}]"), *x)?;
+    }
+    Ok(v)
+}
+
+/// A simulated noise standard deviation [m]: zero (a perfect sensor) up to the
+/// Earth's quadrant, as [`domain::POSITION_STD`] bounds a filter's.
+const SIM_POSITION_STD: Domain = Domain {
+    min: 0.0,
+    ..domain::POSITION_STD
+};
+/// A simulated velocity noise standard deviation [m/s]: zero up to the escape
+/// velocity.
+const SIM_VELOCITY_STD: Domain = Domain {
+    min: 0.0,
+    ..domain::VELOCITY_STD
+};
+/// An outlier's jump or a bias of a position or height [m]: within the Earth's
+/// quadrant, either sign.
+const SIM_OFFSET: Domain = Domain {
+    quantity: "offset",
+    min: -1e7,
+    why: "at most the Earth's quadrant",
+    ..domain::POSITION_STD
+};
+
 impl GnssSpec {
     /// The SI model.
     pub fn model(&self) -> Result<GnssModel, ScenarioError> {
@@ -431,15 +475,23 @@ impl GnssSpec {
         let zero = || Ok(Vector3::zeros());
         Ok(GnssModel {
             interval: 1.0 / self.rate_hz,
-            pos_std: vec3(&self.position_std, "gnss.position_std", Dimension::Length)?,
-            vel_std: self
-                .velocity_std
-                .as_ref()
-                .map_or_else(zero, |v| vec3(v, "gnss.velocity_std", Dimension::Velocity))?,
-            lever_arm: self
-                .lever_arm
-                .as_ref()
-                .map_or_else(zero, |v| vec3(v, "gnss.lever_arm", Dimension::Length))?,
+            pos_std: vec3_in(
+                &self.position_std,
+                "gnss.position_std",
+                Dimension::Length,
+                &SIM_POSITION_STD,
+            )?,
+            vel_std: self.velocity_std.as_ref().map_or_else(zero, |v| {
+                vec3_in(
+                    v,
+                    "gnss.velocity_std",
+                    Dimension::Velocity,
+                    &SIM_VELOCITY_STD,
+                )
+            })?,
+            lever_arm: self.lever_arm.as_ref().map_or_else(zero, |v| {
+                vec3_in(v, "gnss.lever_arm", Dimension::Length, &domain::LEVER_ARM)
+            })?,
             outages: intervals(&self.outages, "gnss.outages")?,
             outliers: self
                 .outliers
@@ -449,7 +501,12 @@ impl GnssSpec {
                     let k = format!("gnss.outliers[{i}]");
                     Ok(Outlier {
                         t: o.at.si(&format!("{k}.at"), Dimension::Time)?,
-                        jump: vec3(&o.jump, &format!("{k}.jump"), Dimension::Length)?,
+                        jump: vec3_in(
+                            &o.jump,
+                            &format!("{k}.jump"),
+                            Dimension::Length,
+                            &SIM_OFFSET,
+                        )?,
                     })
                 })
                 .collect::<Result<_, ScenarioError>>()?,
@@ -496,13 +553,25 @@ impl BaroSpec {
                 message: format!("must be a positive number of Hz, got {}", self.rate_hz),
             });
         }
-        let opt =
-            |q: &Option<Quantity>, key: &str, dim| q.as_ref().map_or(Ok(0.0), |q| q.si(key, dim));
+        let opt = |q: &Option<Quantity>, key: &str, dim, domain: &Domain| {
+            q.as_ref()
+                .map_or(Ok(0.0), |q| within(domain, key, q.si(key, dim)?))
+        };
         Ok(BaroModel {
             interval: 1.0 / self.rate_hz,
-            bias: opt(&self.bias, "baro.bias", Dimension::Length)?,
-            drift: opt(&self.drift, "baro.drift", Dimension::Velocity)?,
-            noise: opt(&self.noise, "baro.noise", Dimension::Length)?,
+            bias: opt(&self.bias, "baro.bias", Dimension::Length, &SIM_OFFSET)?,
+            drift: opt(
+                &self.drift,
+                "baro.drift",
+                Dimension::Velocity,
+                &domain::SPEED,
+            )?,
+            noise: opt(
+                &self.noise,
+                "baro.noise",
+                Dimension::Length,
+                &SIM_POSITION_STD,
+            )?,
             dropouts: intervals(&self.dropouts, "baro.dropouts")?,
             outliers: self
                 .outliers
@@ -512,7 +581,11 @@ impl BaroSpec {
                     let k = format!("baro.outliers[{i}]");
                     Ok(Outlier {
                         t: o.at.si(&format!("{k}.at"), Dimension::Time)?,
-                        jump: o.jump.si(&format!("{k}.jump"), Dimension::Length)?,
+                        jump: within(
+                            &SIM_OFFSET,
+                            &format!("{k}.jump"),
+                            o.jump.si(&format!("{k}.jump"), Dimension::Length)?,
+                        )?,
                     })
                 })
                 .collect::<Result<_, ScenarioError>>()?,
