@@ -302,7 +302,8 @@ fn integration(
 pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
     let y = read_yaml(path)?;
     let key = |k: &str| format!("{}: {k}", path.display());
-    let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)?;
+    let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)
+        .with_context(|| format!("{}: gnsspath", path.display()))?;
     // KF-GINS skips the fixes up to and including `starttime` (its start is the
     // configured state, not a fix).
     fixes.retain(|f| f.t > y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));

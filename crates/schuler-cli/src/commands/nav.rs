@@ -267,6 +267,15 @@ fn read_options(args: &NavArgs, cfg: &NavConfig) -> Result<ImuReadOptions> {
 
 /// Merge flags over the config file and check every value (see [`NavPlan`]).
 pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
+    // A value may come from the configuration file: its errors name it.
+    match args.config.clone() {
+        Some(config) => plan(args).with_context(|| format!("with --config {}", config.display())),
+        None => plan(args),
+    }
+}
+
+/// [`parse_nav_args`] itself.
+fn plan(args: NavArgs) -> Result<NavPlan> {
     let cfg = match &args.config {
         Some(p) => load_config(p)?,
         None => NavConfig::default(),
