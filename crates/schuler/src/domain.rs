@@ -37,9 +37,9 @@ pub struct DomainError {
     pub value: f64,
 }
 
-/// `v` in plain decimals, or in exponent form from 1e9 up.
+/// `v` in plain decimals, or in exponent form from 1e9 up and below 1e-6.
 fn number(v: f64) -> String {
-    if v.is_finite() && v.abs() >= 1e9 {
+    if v.is_finite() && (v.abs() >= 1e9 || (v != 0.0 && v.abs() < 1e-6)) {
         format!("{v:e}")
     } else {
         format!("{v}")

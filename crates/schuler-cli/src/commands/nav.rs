@@ -725,19 +725,38 @@ fn print_aided(
         + c.odometer
         + c.heading
         + c.rejected;
+    let nis = summary.nav.mean_nis_per_dof;
+    let wrote = format!(
+        "wrote {} epochs to {} (and nav.csv, std.txt, imu_err.txt, rejected.csv)",
+        summary.epochs,
+        settings.out.join("nav.txt").display()
+    );
+    if c.rejected * 2 > tried && nis > INCONSISTENT_NIS_PER_DOF {
+        println!("{wrote}");
+        bail!(
+            "the filter disagrees with its measurements: the gate refused {} of {tried} and the \
+             mean NIS per dimension is {nis:.0} (a consistent filter gives 1): its solution and \
+             the standard deviations it reports are not to be trusted. The IMU data do not move \
+             as the aids do: gyro or accelerometer columns swapped or dead, axes mounted \
+             otherwise (--imu-axes, --imu-columns), wrong units, or a far too optimistic noise \
+             model (--imu-grade)",
+            c.rejected
+        );
+    }
     if c.rejected * 10 > tried {
         eprintln!(
             "warning: the gate refused {} of {} measurements (see rejected.csv): the IMU noise model is probably too optimistic for this sensor (--imu-grade, --arw, --gyro-bias-std, ...)",
             c.rejected, tried
         );
     }
-    println!(
-        "wrote {} epochs to {} (and nav.csv, std.txt, imu_err.txt, rejected.csv)",
-        summary.epochs,
-        settings.out.join("nav.txt").display()
-    );
+    println!("{wrote}");
     Ok(())
 }
+
+/// Mean NIS per dimension beyond which, with most measurements refused, a run is
+/// reported as failed: 100 is 10 standard deviations per dimension on average, where a
+/// consistent filter gives 1 and a noise model optimistic by a factor of 3 gives 9.
+const INCONSISTENT_NIS_PER_DOF: f64 = 100.0;
 
 /// When the heading of a start in motion converged (its standard deviation below 1°).
 fn print_heading_settled(summary: &RunSummary) {

@@ -635,6 +635,22 @@ pub(crate) fn position_in_domain(
     Ok(Geodetic { lat, lon, h })
 }
 
+/// `fix` (read from line `n` of `path`) if every value it carries is within its
+/// physical domain ([`schuler::session::Aid::out_of_domain`]), else the error naming
+/// the line and the field.
+pub(crate) fn fix_in_domain(path: &Path, n: u64, fix: GnssFix) -> Result<GnssFix, InputError> {
+    match schuler::session::Aid::Gnss(fix).out_of_domain() {
+        None => Ok(fix),
+        Some((field, e)) => Err(InputError::new(
+            InputErrorKind::OutOfDomain,
+            path,
+            n,
+            Some(field),
+            e.to_string(),
+        )),
+    }
+}
+
 /// The record of line `n`'s values `v` (`t lat lon h [std_n std_e std_d [vn ve vd
 /// std_vn std_ve std_vd]]`) after checking the position's domain (the fields named
 /// `pos_names` in the error); `default_std` where `v` gives no standard deviations.

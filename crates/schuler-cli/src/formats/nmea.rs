@@ -37,7 +37,7 @@
 use super::error::InputError;
 use super::gnss::{
     GnssFormat, GnssLog, GnssQuality, GnssReadOptions, below_quality, count_warnings, default_std,
-    no_usable_fix, position_in_domain,
+    fix_in_domain, no_usable_fix, position_in_domain,
 };
 use super::gps_time::{DAY_S, TimeScale, WeekClock, week_sow};
 use ::nmea::ParseResult;
@@ -427,12 +427,27 @@ fn fix(
         }
         _ => default_std(path, gga.line, "GST", opts.default_std)?,
     };
-    Ok(Some(GnssFix {
+    let fix = GnssFix {
         t,
         pos,
         pos_std,
         vel: velocity(e, opts.vel_std),
-    }))
+    };
+    // Out of its domain, a fix is a bad sentence: counted and skipped like one.
+    match fix_in_domain(path, gga.line, fix) {
+        Ok(fix) => Ok(Some(fix)),
+        Err(e) => {
+            counts.bad(
+                gga.line,
+                format!(
+                    "a fix out of range: {}: {}",
+                    e.field.unwrap_or_default(),
+                    e.message
+                ),
+            );
+            Ok(None)
+        }
+    }
 }
 
 /// Read an NMEA 0183 log (`bytes`, the content of `path`) as GNSS fixes (the module

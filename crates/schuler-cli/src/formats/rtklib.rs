@@ -37,7 +37,7 @@
 use super::error::{InputError, InputErrorKind, quote_field};
 use super::gnss::{
     GnssFormat, GnssLog, GnssQuality, GnssReadOptions, below_quality, check_time, count_warnings,
-    default_std, no_usable_fix, parse_field, position_in_domain,
+    default_std, fix_in_domain, no_usable_fix, parse_field, position_in_domain,
 };
 use super::gps_time::{TimeScale, WeekClock, date_of_week, week_sow};
 use super::lines::{fields, is_skippable};
@@ -590,7 +590,7 @@ pub fn read_rtklib(path: &Path, text: &str, opts: &GnssReadOptions) -> Result<Gn
             fix.pos_std = default_std(path, n, sd, opts.default_std)?;
             counts.defaulted += usize::from(layout.find(Col::Sd(0)).is_some());
         }
-        fixes.push(fix);
+        fixes.push(fix_in_domain(path, n, fix)?);
     }
     let warnings = count_warnings(&[
         (
