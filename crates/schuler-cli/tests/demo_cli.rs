@@ -49,10 +49,11 @@ fn num(s: &str) -> f64 {
     s.parse().unwrap_or_else(|_| panic!("not a number: {s:?}"))
 }
 
-const SECTIONS: [&str; 8] = [
+const SECTIONS: [&str; 9] = [
     "sortie",
     "alignment",
     "inertial",
+    "figure3",
     "aided",
     "sensors",
     "vertical",
@@ -240,6 +241,42 @@ fn assert_pole_crossing(out: &Path, polar: &[Vec<String>], crossing: &Crossing) 
 
 /// Same seed, same data: the data files of `out` and `again` are the same bytes (run
 /// times aside).
+/// Figure 3 against figure 2 (`figure3.csv`): three legs of equal length, each row's
+/// largest circular error is its errors CSV's over the leg, and the closed forms'
+/// terms add up to a bound that holds.
+fn assert_figure3(out: &Path, html: &str) {
+    let legs = rows(&out.join("figure3.csv"));
+    let keys = ["inertial_coarse", "inertial", "inertial_fig3"];
+    assert_eq!(legs.len(), keys.len());
+    let fig3 = ErrorsCsv(rows(&out.join("errors_inertial_fig3.csv")));
+    let end = fig3.0.last().map(|r| num(&r[0])).expect("epochs");
+    let length = end - num(&legs[2][1]);
+    for (leg, key) in legs.iter().zip(keys) {
+        let errors = ErrorsCsv(rows(&out.join(format!("errors_{key}.csv"))));
+        let t0 = num(&leg[1]);
+        let max = errors
+            .0
+            .iter()
+            .filter(|e| num(&e[0]) >= t0 && num(&e[0]) <= t0 + length)
+            .map(|e| num(&e[3]))
+            .fold(0.0, f64::max);
+        assert_eq!(leg[14], format!("{max:.3}"), "{key}");
+        let terms: f64 = leg[7..13].iter().map(|x| num(x)).sum();
+        // Six terms rounded to the millimetre: within 3 mm.
+        assert!(
+            (terms - num(&leg[13])).abs() < 0.01,
+            "{key}: terms {terms} vs bound {}",
+            leg[13]
+        );
+        assert!(
+            num(&leg[13]) >= max,
+            "{key}: the bound {} under the error {max}",
+            leg[13]
+        );
+    }
+    in_table_in_order(html, "id=\"figure3\"", &legs[2]);
+}
+
 fn assert_same_data(out: &Path, again: &Path) {
     for f in std::fs::read_dir(out).expect("dir") {
         let name = f.expect("entry").file_name();
@@ -268,6 +305,7 @@ fn quick_demo_report_is_complete_and_agrees_with_its_data() {
     assert_sections_and_plot_units(&html);
     let sortie = Sortie::quick().expect("quick sortie");
     assert_sortie_summary(&out, &html, &sortie);
+    assert_figure3(&out, &html);
     let crossing = Crossing::quick(&sortie).expect("quick crossing");
     let polar = assert_polar_summary(&out, &html, &crossing);
     assert_pole_crossing(&out, &polar, &crossing);

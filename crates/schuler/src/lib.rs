@@ -14,6 +14,7 @@ pub mod filter;
 pub mod imu;
 pub mod lab;
 pub mod nav;
+pub mod refine;
 pub mod rotation;
 pub mod session;
 pub mod sim;

@@ -16,8 +16,10 @@
 mod capture;
 mod crossing;
 mod errors;
+mod figure3;
 mod modes;
 mod page;
+mod page_figure3;
 mod page_polar;
 mod polar;
 mod sortie;
@@ -248,6 +250,9 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let settings = aided_settings(&sortie)?;
     let flight = (span - sortie.nav_start()) as u64;
     let runs = navigate_sortie(&rec, &alignments, gains, &settings, &multi, flight);
+    let fig3_bar = bar(&multi, "inertial, figure 3's leg", flight);
+    let fig3 = figure3::figure3(&rec, &sortie, &alignments, &runs, gains, &fig3_bar)?;
+    fig3_bar.finish();
 
     let crossing = if args.quick {
         crossing::Crossing::quick(&sortie)?
@@ -266,6 +271,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         &alignments,
         &runs,
         &polar,
+        &fig3,
         gains,
         timing,
         started,

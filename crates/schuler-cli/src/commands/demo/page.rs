@@ -661,11 +661,12 @@ pub fn write(
     a: &Alignments,
     runs: &[ModeRun],
     polar: &Polar,
+    fig3: &super::figure3::Figure3,
     gains: Gains,
     timing: Timing,
     started: Instant,
 ) -> Result<String> {
-    for r in runs {
+    for r in runs.iter().chain([&fig3.run]) {
         write_mode(dir, r)?;
     }
     let end = rec.truth.last().map_or(0.0, |e| e.state.t);
@@ -674,6 +675,7 @@ pub fn write(
     sortie_section(dir, &mut report, s, rec, end)?;
     alignment_section(dir, &mut report, rec, a, s)?;
     inertial_section(dir, &mut report, s, rec, a, runs, end)?;
+    super::page_figure3::section(dir, &mut report, runs, fig3)?;
     aided_section(dir, &mut report, s, rec, runs)?;
     sensors(dir, &mut report, rec, &find(runs, "aided")?.track)?;
     vertical_section(dir, &mut report, runs, gains)?;
