@@ -241,12 +241,17 @@ impl SmootherLog {
                 (s_next, ps_next, dx_next) = (s, ps, e.dx);
             }
         }
+        // Without an epoch (a log never started) there is nothing to smooth.
+        let outputs = match n {
+            0 => Records::new(OUTPUT_WIDTH, 0),
+            _ => self.outputs,
+        };
         Ok(SmoothedTrajectory {
             layout: *layout,
             backward,
             estimates: self.estimates,
-            remaining: self.outputs.len(),
-            outputs: self.outputs.into_sequence()?,
+            remaining: outputs.len(),
+            outputs: outputs.into_sequence()?,
         })
     }
 }
@@ -492,6 +497,22 @@ mod tests {
             }
         }
         log
+    }
+
+    #[test]
+    fn outputs_without_an_epoch_smooth_to_nothing() {
+        let mut log = SmootherLog::default();
+        let state = NavState::new(
+            0.0,
+            Geodetic::from_degrees(45.0, 7.0, 300.0),
+            Vector3::zeros(),
+            Euler::new(0.0, 0.0, 0.0),
+        );
+        let mech = LocalLevel::new(Wgs84, state);
+        log.output(mech.frame(), SensorEstimates::default());
+        let smoothed = log.smooth(&Layout::core()).expect("smooth");
+        assert!(smoothed.is_empty());
+        assert_eq!(smoothed.collect_states(Wgs84).expect("states").len(), 0);
     }
 
     #[test]
