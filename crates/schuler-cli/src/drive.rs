@@ -17,7 +17,7 @@ use anyhow::Result;
 use schuler::earth::EarthModel;
 use schuler::filter::SensorEstimates;
 use schuler::filter::integration::SkipReason;
-use schuler::filter::smoother::Smoothed;
+use schuler::filter::smoother::SmoothedTrajectory;
 use schuler::imu::ImuSample;
 use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session};
 use schuler::units::{DEG_PER_H, MGAL, PPM};
@@ -482,17 +482,19 @@ where
     }))
 }
 
-/// The smoothed trajectory: `nav.txt`, `nav.csv`, `std.txt`, `imu_err.txt` in `dir`.
+/// The smoothed trajectory: `nav.txt`, `nav.csv`, `std.txt`, `imu_err.txt` in `dir`,
+/// written as it is computed.
 pub fn write_smoothed<E: EarthModel>(
     earth: &E,
     dir: &Path,
     week: u32,
-    smoothed: &[Smoothed],
+    smoothed: SmoothedTrajectory,
 ) -> Result<()> {
     let mut nav = NavWriter::create_extended(dir, week, earth)?;
     let mut std = Table::create(dir, "std.txt")?;
     let mut err = Table::create(dir, "imu_err.txt")?;
-    for s in smoothed {
+    for s in smoothed.states(*earth) {
+        let s = s?;
         nav.write_epoch(&NavEpoch {
             state: s.state,
             r_e: earth.geodetic_to_ecef(&s.state.pos),

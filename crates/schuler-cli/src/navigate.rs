@@ -184,12 +184,12 @@ fn finish_aided<E: EarthModel>(
     settings: &NavSettings,
     a: &Aiding,
     files: FilterFiles,
-    finished: &Finished,
+    finished: &mut Finished,
     failure: Option<anyhow::Error>,
 ) -> Result<String> {
     let out = &settings.out;
     let log = files.finish(out)?;
-    if let Some(smoothed) = &finished.smoothed {
+    if let Some(smoothed) = finished.smoothed.take() {
         write_smoothed(earth, &out.join("smoothed"), settings.week, smoothed)?;
     }
     if let Some(e) = failure {
@@ -246,14 +246,14 @@ fn conclude<E: EarthModel>(
         );
     };
     let Driven {
-        finished,
+        mut finished,
         failure,
         epochs,
         filter,
         heading_settled,
     } = driven;
     let report_text = match (aiding, filter) {
-        (Some(a), Some(files)) => finish_aided(earth, settings, a, files, &finished, failure)?,
+        (Some(a), Some(files)) => finish_aided(earth, settings, a, files, &mut finished, failure)?,
         _ => match failure {
             Some(e) => return Err(e),
             None => String::new(),

@@ -82,7 +82,7 @@ fn navigate<'py>(
         None => None,
     };
     let mut tables = Tables::default();
-    let finished = py
+    let (finished, smoothed) = py
         .detach(|| -> anyhow::Result<_> {
             let mut session = AnySession::open(&plan)?;
             let (s, t) = (&plan.settings, &mut tables);
@@ -103,7 +103,7 @@ fn navigate<'py>(
         })
         .py_err(py)?;
     let d = tables.take_dict(py)?;
-    session::add_finished(py, &d, &finished)?;
+    session::add_finished(py, &d, &finished, smoothed.as_deref())?;
     Ok(d)
 }
 

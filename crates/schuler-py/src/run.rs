@@ -109,11 +109,16 @@ impl AnySession {
     }
 
     /// Ends the input and the session; the epochs and events it still held go to
-    /// `tables`.
-    pub fn finish(mut self, tables: &mut Tables) -> Result<Finished> {
+    /// `tables`, the smoothed trajectory (when asked) is read into memory.
+    pub fn finish(mut self, tables: &mut Tables) -> Result<(Finished, Option<Vec<Smoothed>>)> {
         each!(&mut self, x => x.end_of_input());
         self.take(tables);
-        Ok(each!(self, x => x.finish())?)
+        each!(self, x => {
+            let earth = x.earth();
+            let mut finished = x.finish()?;
+            let smoothed = finished.smoothed.take().map(|s| s.collect_states(earth));
+            Ok((finished, smoothed.transpose()?))
+        })
     }
 }
 

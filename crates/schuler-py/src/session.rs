@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
+use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::{Aid, Finished};
 use schuler_cli::aided::GivenReadings;
@@ -163,9 +164,9 @@ impl PySession {
             .open
             .take()
             .ok_or_else(|| crate::errors::SchulerError::new_err("the session is finished"))?;
-        let finished = py.detach(|| session.finish(&mut tables)).py_err(py)?;
+        let (finished, smoothed) = py.detach(|| session.finish(&mut tables)).py_err(py)?;
         let d = tables.take_dict(py)?;
-        add_finished(py, &d, &finished)?;
+        add_finished(py, &d, &finished, smoothed.as_deref())?;
         Ok(d)
     }
 }
@@ -180,8 +181,13 @@ impl PySession {
 }
 
 /// Adds `smoothed` (or None) and `summary` of a finished session to `d`.
-pub fn add_finished(py: Python<'_>, d: &Bound<'_, PyDict>, f: &Finished) -> PyResult<()> {
-    match &f.smoothed {
+pub fn add_finished(
+    py: Python<'_>,
+    d: &Bound<'_, PyDict>,
+    f: &Finished,
+    smoothed: Option<&[Smoothed]>,
+) -> PyResult<()> {
+    match smoothed {
         Some(s) => d.set_item("smoothed", smoothed_columns(s).take_dict(py)?)?,
         None => d.set_item("smoothed", py.None())?,
     }

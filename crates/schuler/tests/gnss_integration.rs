@@ -283,6 +283,10 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
         |t: f64| d.truth[((t - d.truth[0].t) / (d.truth[1].t - d.truth[0].t)).round() as usize];
     let smoothed = integ
         .smoothed()
+        .map(|s| s.expect("the smoother's record").collect_states(Wgs84))
+        .transpose()
+        .expect("the smoothed trajectory")
+        .unwrap_or_default()
         .iter()
         .map(|s| {
             let truth = truth_at(s.state.t);

@@ -416,12 +416,14 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
     }
 
-    /// The smoothed trajectory at the recorded outputs (empty without
-    /// [`Integrator::with_smoother`]).
-    pub fn smoothed(&self) -> Vec<super::smoother::Smoothed> {
-        self.smoother
-            .as_ref()
-            .map_or_else(Vec::new, |log| log.smooth(&self.earth, &self.model.layout))
+    /// The smoothed trajectory at the recorded outputs, read as it is computed
+    /// (`None` without [`Integrator::with_smoother`]); the record is taken, so a second
+    /// call gives `None`.
+    pub fn smoothed(
+        &mut self,
+    ) -> Option<Result<super::smoother::SmoothedTrajectory, super::spill::SpillError>> {
+        let layout = self.model.layout;
+        self.smoother.take().map(|log| log.smooth(&layout))
     }
 
     /// The mechanization (current state).

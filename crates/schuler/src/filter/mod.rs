@@ -10,7 +10,8 @@
 //! - [`vehicle`]: zero velocity and angular rate at rest, the non-holonomic
 //!   constraint, odometer speed, dual-antenna heading;
 //! - [`integration`]: the loosely coupled INS/GNSS filter loop;
-//! - [`smoother`]: the Rauch–Tung–Striebel backward pass;
+//! - [`smoother`]: the Rauch–Tung–Striebel backward pass, over [`spill`]'s records
+//!   (memory up to a budget, then a temporary file);
 //! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
 //!   innovation gate.
 
@@ -22,6 +23,7 @@ pub mod layout;
 pub mod measurement;
 pub mod noise;
 pub mod smoother;
+pub mod spill;
 pub mod vehicle;
 
 pub use error_model::{ErrorModel, IntervalMeans};

@@ -71,11 +71,22 @@ pub fn corrected_ecef(
     f: &FrameSnapshot,
     e: &NavErrors,
 ) -> (Vector3<f64>, Vector3<f64>, UnitQuaternion<f64>) {
-    let c_ec = f.c_ce_to_e;
-    let r = f.r_e - c_ec * e.dr;
-    let v = c_ec * (f.v_c - e.dv);
-    let q_ce = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(c_ec));
-    let q_be = q_ce * quaternion_from_rotation_vector(&e.psi) * f.q_bc;
+    corrected_ecef_of(&f.c_ce_to_e, &f.r_e, &f.v_c, &f.q_bc, e)
+}
+
+/// [`corrected_ecef`] from the parts of a snapshot it uses: `c_ec` (`c` to ECEF),
+/// ECEF position `r_e`, velocity in `c` `v_c` and attitude body to `c` `q_bc`.
+pub fn corrected_ecef_of(
+    c_ec: &Matrix3<f64>,
+    r_e: &Vector3<f64>,
+    v_c: &Vector3<f64>,
+    q_bc: &UnitQuaternion<f64>,
+    e: &NavErrors,
+) -> (Vector3<f64>, Vector3<f64>, UnitQuaternion<f64>) {
+    let r = r_e - c_ec * e.dr;
+    let v = c_ec * (v_c - e.dv);
+    let q_ce = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*c_ec));
+    let q_be = q_ce * quaternion_from_rotation_vector(&e.psi) * q_bc;
     (r, v, q_be)
 }
 

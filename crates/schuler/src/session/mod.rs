@@ -47,7 +47,7 @@ use crate::channel::vertical::DetectorCounts;
 use crate::earth::EarthModel;
 use crate::filter::integration::{Counts, SkipReason, Skipped};
 use crate::filter::measurement::Kind;
-use crate::filter::smoother::Smoothed;
+use crate::filter::smoother::SmoothedTrajectory;
 use crate::filter::{Integrator, Layout};
 use crate::imu::ImuSample;
 use crate::nav::{BaroLoop, ErrorFrame, Mechanization, NavState};
@@ -104,6 +104,9 @@ pub enum SessionError {
     /// No IMU sample was pushed.
     #[error("no IMU sample was pushed: nothing to navigate")]
     NoImu,
+    /// The smoother's record could not be kept (its temporary file failed).
+    #[error(transparent)]
+    Smoother(#[from] crate::filter::spill::SpillError),
     /// The solution stopped being a number (an input far outside what the sensors can
     /// read, or a diverged filter); nothing after it is computed.
     #[error(
@@ -159,7 +162,7 @@ pub struct Summary {
 }
 
 /// Everything a session leaves at its end.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Finished {
     /// What it did.
     pub summary: Summary,
@@ -170,8 +173,8 @@ pub struct Finished {
     /// The filter's snapshots (empty without a filter).
     pub snapshots: Vec<Snapshot>,
     /// The smoothed trajectory at every output epoch, when asked
-    /// ([`FilterConfig::smooth`]).
-    pub smoothed: Option<Vec<Smoothed>>,
+    /// ([`FilterConfig::smooth`]), computed as it is read.
+    pub smoothed: Option<SmoothedTrajectory>,
 }
 
 /// Everything of a session but its running navigation (so that the two can be
@@ -278,6 +281,11 @@ impl<E: EarthModel> Session<E> {
     /// The configuration.
     pub fn config(&self) -> &SessionConfig {
         &self.run.cfg
+    }
+
+    /// The Earth model (the one [`Finished::smoothed`] is read on).
+    pub fn earth(&self) -> E {
+        self.earth
     }
 
     /// Push the next IMU sample (times strictly increasing). Samples older than the
@@ -433,7 +441,7 @@ impl<E: EarthModel> Session<E> {
     /// taken yet, the snapshots and, when asked, the smoothed trajectory.
     pub fn finish(mut self) -> Result<Finished, SessionError> {
         self.end_of_input();
-        let Some(core) = self.core else {
+        let Some(mut core) = self.core else {
             return Err(SessionError::NoImu);
         };
         if let Some(e) = self.run.failure {
@@ -447,9 +455,9 @@ impl<E: EarthModel> Session<E> {
             });
         }
         let run = self.run;
-        let end = match &core {
-            Core::FilterNed(i) => filter_end(i, &run.cfg),
-            Core::FilterWander(i) => filter_end(i, &run.cfg),
+        let end = match &mut core {
+            Core::FilterNed(i) => filter_end(i, &run.cfg)?,
+            Core::FilterWander(i) => filter_end(i, &run.cfg)?,
             _ => FilterEnd {
                 counts: Counts {
                     skipped: run.skipped_free,
@@ -552,15 +560,15 @@ struct FilterEnd {
     layout: Option<Layout>,
     estimates: Option<crate::filter::SensorEstimates>,
     mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
-    smoothed: Option<Vec<Smoothed>>,
+    smoothed: Option<SmoothedTrajectory>,
 }
 
 /// The filter's counts, layout, estimates and mount, and the smoothed trajectory when
 /// asked.
 fn filter_end<M: ErrorFrame, E: EarthModel>(
-    i: &Integrator<M, E>,
+    i: &mut Integrator<M, E>,
     cfg: &SessionConfig,
-) -> FilterEnd {
+) -> Result<FilterEnd, SessionError> {
     let filter = cfg.filter.as_ref();
     let smooth = filter.is_some_and(|f| f.smooth);
     let p = i.covariance();
@@ -571,13 +579,18 @@ fn filter_end<M: ErrorFrame, E: EarthModel>(
         )),
         _ => None,
     };
-    FilterEnd {
+    let smoothed = if smooth {
+        i.smoothed().transpose()?
+    } else {
+        None
+    };
+    Ok(FilterEnd {
         counts: i.counts,
         layout: Some(i.layout()),
         estimates: Some(i.estimates()),
         mounting,
-        smoothed: smooth.then(|| i.smoothed()),
-    }
+        smoothed,
+    })
 }
 
 impl Loop {

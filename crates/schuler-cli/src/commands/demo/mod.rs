@@ -179,7 +179,7 @@ fn navigate_sortie(
     aided_settings: &modes::AidedSettings,
     multi: &MultiProgress,
     flight: u64,
-) -> Vec<ModeRun> {
+) -> Result<Vec<ModeRun>> {
     let fine_start = modes::Start::from_alignment(&alignments.fine);
     let coarse_start = modes::Start::from_alignment(&alignments.coarse_only);
     let bars = [
@@ -210,10 +210,11 @@ fn navigate_sortie(
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (aided, inertial, coarse_only, no_baro)
     });
+    let (forward, smoothed) = (forward, smoothed?);
     for b in &bars {
         b.finish();
     }
-    [
+    Ok([
         (
             "inertial_coarse",
             "inertial after coarse alignment only",
@@ -230,7 +231,7 @@ fn navigate_sortie(
     ]
     .into_iter()
     .map(|(key, label, track)| ModeRun::new(key, label, track, |t| errors::errors(t, rec)))
-    .collect()
+    .collect())
 }
 
 /// `schuler demo`.
@@ -249,7 +250,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let gains = modes::baro_gains(&modes::Start::from_alignment(&alignments.fine).state)?;
     let settings = aided_settings(&sortie)?;
     let flight = (span - sortie.nav_start()) as u64;
-    let runs = navigate_sortie(&rec, &alignments, gains, &settings, &multi, flight);
+    let runs = navigate_sortie(&rec, &alignments, gains, &settings, &multi, flight)?;
     let fig3_bar = bar(&multi, "inertial, figure 3's leg", flight);
     let fig3 = figure3::figure3(&rec, &sortie, &alignments, &runs, gains, &fig3_bar)?;
     fig3_bar.finish();

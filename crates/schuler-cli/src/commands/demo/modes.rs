@@ -11,6 +11,7 @@ use schuler::channel::detector::DetectorConfig;
 use schuler::channel::vertical::{DetectorCounts, Gains};
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::{IntegrationConfig, SensorEstimates};
+use schuler::filter::spill::SpillError;
 use schuler::filter::{GnssFix, ImuNoise};
 use schuler::nav::NavState;
 use schuler::session::{
@@ -186,7 +187,8 @@ pub struct AidedSettings {
 
 /// The inertial-satellite mode on the mechanization `choice`: the 15-state
 /// error-state filter (plus the barometer bias) from `start` with the uncertainties
-/// `prior`; returns the forward track and the Rauch–Tung–Striebel smoothed one.
+/// `prior`; returns the forward track and the Rauch–Tung–Striebel smoothed one (or
+/// why the smoother's record could not be kept).
 pub fn aided(
     rec: &Recording,
     start: &Start,
@@ -194,7 +196,7 @@ pub fn aided(
     settings: &AidedSettings,
     choice: MechanizationChoice,
     bar: &ProgressBar,
-) -> (Track, Track) {
+) -> (Track, Result<Track, SpillError>) {
     let integration = IntegrationConfig {
         lever_arm: settings.lever_arm,
         baro: Some(settings.baro_bias),
@@ -221,7 +223,11 @@ pub fn aided(
         })
         .collect();
     let clock = Instant::now();
-    let smoothed = finished.smoothed.unwrap_or_default();
+    let smoothed = match finished.smoothed.map(|s| s.collect_states(Wgs84)) {
+        Some(Ok(s)) => s,
+        Some(Err(e)) => return (forward, Err(e)),
+        None => Vec::new(),
+    };
     let back = Track {
         epochs: smoothed
             .iter()
@@ -236,5 +242,5 @@ pub fn aided(
         baro: None,
         seconds: forward.seconds + clock.elapsed().as_secs_f64(),
     };
-    (forward, back)
+    (forward, Ok(back))
 }

@@ -75,6 +75,7 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (aided, inertial, ned)
     });
+    let smoothed = smoothed?;
     for b in &bars {
         b.finish();
     }
