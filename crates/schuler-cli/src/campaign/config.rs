@@ -85,6 +85,16 @@ impl CampaignConfig {
         })
     }
 
+    /// The configuration with `flags` over `[navigate]`'s: a flag given in both is
+    /// `flags`' alone.
+    pub fn with_flags(mut self, flags: &[String]) -> Self {
+        let name = |f: &str| f.split('=').next().unwrap_or(f).to_string();
+        let given: Vec<String> = flags.iter().map(|f| name(f)).collect();
+        self.nav_flags.retain(|f| !given.contains(&name(f)));
+        self.nav_flags.extend_from_slice(flags);
+        self
+    }
+
     /// The configuration in the file `path`.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::formats::read_config_text(path)?;
@@ -173,5 +183,14 @@ baro_std = "0.5 m"
         let text = TEXT.replace("nhc = true", "nhc = { a = 1 }\nx = [{ a = 1 }]");
         let e = CampaignConfig::from_toml(&text, Path::new(""), "test").expect_err("refused");
         assert!(format!("{e:#}").contains("`x`"), "{e:#}");
+    }
+
+    #[test]
+    fn given_flags_replace_the_tables() {
+        let c = CampaignConfig::from_toml(TEXT, Path::new(""), "test").expect("valid");
+        let c = c.with_flags(&["--imu-grade=navigation".into(), "--smooth".into()]);
+        let grades: Vec<&String> = c.nav_flags.iter().filter(|f| f.contains("grade")).collect();
+        assert_eq!(grades, ["--imu-grade=navigation"]);
+        assert_eq!(c.nav_flags.last().map(String::as_str), Some("--smooth"));
     }
 }

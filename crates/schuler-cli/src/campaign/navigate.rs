@@ -33,7 +33,7 @@ pub fn nav_args(flags: &[String]) -> Result<NavArgs> {
             let message: Vec<&str> = text
                 .lines()
                 .map(str::trim)
-                .take_while(|l| !l.starts_with("For more information"))
+                .take_while(|l| !l.starts_with("For more information") && !l.starts_with("Usage:"))
                 .filter(|l| !l.is_empty())
                 .collect();
             anyhow::anyhow!("{}", message.join(" ").trim_start_matches("error: "))
@@ -80,7 +80,10 @@ fn given(data: &Recorded, streams: Streams, with_gnss: bool, with_baro: bool) ->
         data.fixes
             .iter()
             .map(|f| schuler::filter::GnssFix {
-                vel: f.vel.filter(|_| keep_vel),
+                // A receiver simulated without `velocity_std` reports none.
+                vel: f
+                    .vel
+                    .filter(|(_, std)| keep_vel && std.iter().all(|&s| s > 0.0)),
                 ..*f
             })
             .collect()
