@@ -48,6 +48,8 @@ pub struct CampaignConfig {
     pub nav_flags: Vec<String>,
     /// The streams the filter is given.
     pub streams: Streams,
+    /// What the configuration came from (its file), for messages.
+    pub origin: String,
 }
 
 impl CampaignConfig {
@@ -82,6 +84,7 @@ impl CampaignConfig {
             scenario,
             nav_flags,
             streams,
+            origin: origin.to_string(),
         })
     }
 

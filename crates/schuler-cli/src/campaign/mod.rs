@@ -66,7 +66,7 @@ pub fn run_one(c: &CampaignConfig, seed: u64) -> Result<RunResult> {
             nees,
         })
     };
-    inner().with_context(|| format!("the run with seed {seed}"))
+    inner().with_context(|| format!("{}: the run with seed {seed}", c.origin))
 }
 
 /// The seeds of `runs` runs from `seed`: `seed, seed + 1, ...` (wrapping).
@@ -86,7 +86,8 @@ pub fn run(
 }
 
 /// The runs of `c` with the scenario seeds `seeds`, in their order, on `threads`
-/// threads (`None`: one per core).
+/// threads (`None`: one per core). If runs fail, the error is that of the first
+/// failing seed in that order (every run is tried), whatever the threads did first.
 pub fn run_seeds(
     c: &CampaignConfig,
     seeds: &[u64],
@@ -96,5 +97,7 @@ pub fn run_seeds(
         .num_threads(threads.unwrap_or(0))
         .build()
         .context("cannot start the campaign's threads")?;
-    pool.install(|| seeds.par_iter().map(|&s| run_one(c, s)).collect())
+    let all: Vec<Result<RunResult>> =
+        pool.install(|| seeds.par_iter().map(|&s| run_one(c, s)).collect());
+    all.into_iter().collect()
 }
