@@ -6,9 +6,9 @@
 //! seed order and every run's arithmetic happens on one thread, so the table is the
 //! same bits for any number of threads (or machines: a row depends on its seed only).
 //!
-//! A run's seed reproduces it alone: `schuler simulate` of the scenario with that
-//! `seed`, then `schuler nav` with the `[navigate]` options, gives the same samples
-//! and the same navigation.
+//! A run's seed reproduces its data alone: `schuler simulate` of the scenario with
+//! that `seed` writes the same samples (the navigation of those files then differs
+//! only by the files' printed digits of the GNSS fixes and the start).
 
 pub mod aggregate;
 pub mod config;
