@@ -24,8 +24,13 @@ struct NavFlags {
 }
 
 /// `schuler nav`'s arguments from `flags` (`--key=value` or `--key value`); a refusal
-/// is clap's message on one line, without its usage hint.
+/// is clap's error (the Python package makes it a `TypeError`).
 pub fn nav_args(flags: &[String]) -> Result<NavArgs> {
+    Ok(NavFlags::try_parse_from(flags)?.args)
+}
+
+/// [`nav_args`] with a refusal as clap's message on one line, without its usage hint.
+fn nav_args_one_line(flags: &[String]) -> Result<NavArgs> {
     NavFlags::try_parse_from(flags)
         .map(|f| f.args)
         .map_err(|e| {
@@ -98,7 +103,7 @@ pub fn navigate(c: &CampaignConfig, data: &Recorded) -> Result<Navigated> {
         .truth
         .first()
         .context("the simulation gave no IMU sample")?;
-    let plan = parse_nav_args(nav_args(&start_flags(&c.nav_flags, first))?)?;
+    let plan = parse_nav_args(nav_args_one_line(&start_flags(&c.nav_flags, first))?)?;
     if plan.align || plan.init != InitChoice::Given {
         bail!(
             "a campaign starts at the simulated truth: `align` and `init` are not \
