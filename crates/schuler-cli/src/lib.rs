@@ -5,6 +5,7 @@ pub mod aided;
 pub mod alignment;
 pub mod bag;
 pub mod bag_input;
+pub mod campaign;
 pub mod commands;
 pub mod drive;
 pub mod fixed;

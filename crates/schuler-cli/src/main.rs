@@ -37,6 +37,9 @@ enum Command {
     Bag(schuler_cli::commands::bag::Args),
     /// Noise of a static IMU log: Allan deviations, IEEE 952 terms, nav's noise config.
     Allan(schuler_cli::commands::allan::Args),
+    /// Monte-Carlo campaign: N seeds of a scenario simulated, navigated and compared
+    /// on every core; a table of one row per run and a report.
+    Montecarlo(schuler_cli::commands::montecarlo::Args),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +55,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => schuler_cli::commands::compare::run(args),
         Command::Allan(args) => schuler_cli::commands::allan::run(args),
         Command::Bag(args) => schuler_cli::commands::bag::run(args),
+        Command::Montecarlo(args) => schuler_cli::commands::montecarlo::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

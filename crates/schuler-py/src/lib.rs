@@ -8,6 +8,7 @@ mod arrays;
 mod columns;
 mod compare;
 mod errors;
+mod montecarlo;
 mod options;
 mod readers;
 mod run;
@@ -118,6 +119,7 @@ fn _schuler(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     m.add_function(wrap_pyfunction!(allan::allan, m)?)?;
+    m.add_function(wrap_pyfunction!(montecarlo::montecarlo_seeds, m)?)?;
     m.add_class::<session::PySession>()?;
     m.add("SchulerError", m.py().get_type::<errors::SchulerError>())?;
     m.add("InputError", m.py().get_type::<errors::InputError>())?;

@@ -8,14 +8,6 @@ use schuler_cli::aided::AidingOptions;
 use schuler_cli::commands::nav::NavArgs;
 use schuler_cli::imu_input::ImuInputOptions;
 
-/// The options of `schuler nav`.
-#[derive(Parser, Debug)]
-#[command(name = "navigate", no_binary_name = true)]
-struct NavFlags {
-    #[command(flatten)]
-    args: NavArgs,
-}
-
 /// The IMU reader's options with the time window.
 #[derive(Parser, Debug)]
 #[command(name = "read_imu", no_binary_name = true)]
@@ -40,7 +32,7 @@ struct GnssFlags {
 
 /// `schuler nav`'s arguments from `flags`.
 pub fn nav_args(flags: &[String]) -> Result<NavArgs> {
-    Ok(NavFlags::try_parse_from(flags)?.args)
+    schuler_cli::campaign::navigate::nav_args(flags)
 }
 
 /// The IMU reader's options and time window from `flags`.

@@ -8,6 +8,7 @@ pub mod channel;
 pub mod compare;
 pub mod demo;
 pub mod kf_gins;
+pub mod montecarlo;
 pub mod nav;
 pub mod platform;
 pub mod simulate;

@@ -378,10 +378,15 @@ impl Files {
 /// relative to the scenario's folder).
 pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
     let text = crate::formats::read_config_text(path)?;
-    let mut spec: ScenarioSpec =
+    let spec: ScenarioSpec =
         toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
+    with_motion_csv(spec, path.parent().unwrap_or(Path::new("")))
+}
+
+/// `spec` with its `motion_csv` (a path relative to `dir`), if it names one, read.
+pub fn with_motion_csv(mut spec: ScenarioSpec, dir: &Path) -> Result<ScenarioSpec> {
     if let Some(csv) = &spec.motion_csv {
-        let csv_path = path.parent().unwrap_or(Path::new("")).join(csv);
+        let csv_path = dir.join(csv);
         let text =
             String::from_utf8_lossy(&crate::formats::read_lines_whole(&csv_path)?).into_owned();
         let def = schuler::sim::gnss_ins_sim::parse(&text)

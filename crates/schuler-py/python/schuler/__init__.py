@@ -46,6 +46,7 @@ __all__ = [
     "Session",
     "SimResult",
     "compare",
+    "montecarlo",
     "navigate",
     "read_baro",
     "read_gnss",
@@ -414,3 +415,75 @@ def allan(imu: Union[PathLike, Table], per_decade: float = 10.0, max_tau: Option
     out = _frame(d)
     out["m"] = out["m"].astype(np.int64)
     return out
+
+
+#: Columns of a campaign's table (``runs.csv``), after ``seed``.
+CAMPAIGN_COLUMNS = (
+    "epochs",
+    "horizontal_rms_m",
+    "horizontal_max_m",
+    "cep_m",
+    "cep95_m",
+    "vertical_rms_m",
+    "vertical_max_m",
+    "velocity_rms_mps",
+    "roll_rms_deg",
+    "pitch_rms_deg",
+    "yaw_rms_deg",
+    "outage_horizontal_max_m",
+    "outage_vertical_max_m",
+    "nees_position",
+    "nees_velocity",
+    "nees_attitude",
+    "nees_epochs",
+    "mean_nis_per_dof",
+    "rejected",
+)
+
+Campaign = Union[PathLike, str, Mapping[str, Any]]
+
+
+def _campaign_source(campaign: Campaign, portable: bool = False) -> Dict[str, Any]:
+    """Keyword arguments of the native campaign function for a file, TOML text or a
+    dict. ``portable``: a file is sent as its text (with its folder as ``base``), so
+    that a worker on another machine needs only the files the campaign names."""
+    if isinstance(campaign, Mapping):
+        return {"text": json.dumps(campaign), "format": "json"}
+    is_path = isinstance(campaign, os.PathLike) or (
+        isinstance(campaign, str) and "\n" not in campaign and campaign.strip().endswith(".toml")
+    )
+    if not is_path:
+        return {"text": campaign, "format": "toml"}
+    path = os.fspath(campaign)
+    if not portable:
+        return {"path": path}
+    with open(path, encoding="utf-8") as f:
+        return {"text": f.read(), "format": "toml", "base": os.path.dirname(os.path.abspath(path))}
+
+
+def _campaign_frame(columns: Mapping[str, Any]) -> pd.DataFrame:
+    return pd.DataFrame({"seed": columns["seed"], **{c: columns[c] for c in CAMPAIGN_COLUMNS}})
+
+
+def montecarlo(
+    campaign: Campaign,
+    runs: int,
+    seed: int = 1,
+    threads: Optional[int] = None,
+    **options: Any,
+) -> pd.DataFrame:
+    """A Monte-Carlo campaign, as ``schuler montecarlo``: ``runs`` runs of a campaign
+    (a ``.toml`` file, TOML text or a dict: a ``schuler simulate`` scenario with a
+    ``[navigate]`` table of ``schuler nav`` options and an optional ``[campaign]``
+    table), run ``k`` with the scenario seed ``seed + k``: simulated, navigated from
+    the truth at its first sample, compared with the truth. ``options`` are nav's
+    flags added after ``[navigate]``'s (they win). Returns one row per run, the
+    columns of ``runs.csv`` (``seed``, then :data:`CAMPAIGN_COLUMNS`: error statistics
+    [m, m/s, deg], time-averaged NEES of position, velocity and attitude (3 dof each),
+    mean NIS per dof, rejected measurements), the same bits for any ``threads``
+    (None: one per core). The GIL is released while it runs."""
+    if runs < 1:
+        raise ValueError("runs must be at least 1")
+    seeds = [(seed + k) % 2**64 for k in range(runs)]
+    d = _schuler.montecarlo_seeds(seeds, flags=_flags(options), threads=threads, **_campaign_source(campaign))
+    return _campaign_frame(d)

@@ -66,3 +66,12 @@ def allan(
     per_decade: float = 10.0,
     max_tau: Optional[float] = None,
 ) -> Dict[str, F64]: ...
+def montecarlo_seeds(
+    seeds: List[int],
+    path: Optional[str] = None,
+    text: Optional[str] = None,
+    format: str = "toml",
+    base: Optional[str] = None,
+    flags: List[str] = ...,
+    threads: Optional[int] = None,
+) -> Dict[str, Any]: ...

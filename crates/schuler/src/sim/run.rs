@@ -263,8 +263,20 @@ pub fn simulate(
     spec: &ScenarioSpec,
     sink: &mut (impl SimSink + Send),
 ) -> Result<SimSummary, SimError> {
-    simulate_with(
+    simulate_on(spec, default_workers(), sink)
+}
+
+/// [`simulate`] on `workers` threads (at least one; the bits do not depend on it): for
+/// a caller that runs many simulations at once, such as a Monte-Carlo campaign that
+/// gives each of them one.
+pub fn simulate_on(
+    spec: &ScenarioSpec,
+    workers: usize,
+    sink: &mut (impl SimSink + Send),
+) -> Result<SimSummary, SimError> {
+    workers_with(
         spec,
+        workers,
         |block: &SimBlock, copy: &mut SimBlock| {
             // Field by field: a Vec's clone_from keeps its memory.
             copy.imu.clone_from(&block.imu);
@@ -288,11 +300,25 @@ pub fn simulate_with<T: Default + Send>(
     format: impl Fn(&SimBlock, &mut T) + Sync,
     write: impl FnMut(&mut T) -> std::io::Result<()> + Send,
 ) -> Result<SimSummary, SimError> {
-    let workers = std::thread::available_parallelism()
+    workers_with(spec, default_workers(), format, write)
+}
+
+/// As many workers as there are cores, at most 8.
+fn default_workers() -> usize {
+    std::thread::available_parallelism()
         .map_or(1, usize::from)
-        .clamp(1, 8);
+        .clamp(1, 8)
+}
+
+/// [`simulate_with`] on `workers` threads.
+fn workers_with<T: Default + Send>(
+    spec: &ScenarioSpec,
+    workers: usize,
+    format: impl Fn(&SimBlock, &mut T) + Sync,
+    write: impl FnMut(&mut T) -> std::io::Result<()> + Send,
+) -> Result<SimSummary, SimError> {
     let run = Run {
-        workers,
+        workers: workers.max(1),
         block: BLOCK,
     };
     match spec.earth {
