@@ -7,7 +7,7 @@
 //! Linux), so the figures are the peaks of one case each.
 //!
 //! `cargo bench -p schuler --bench memory` prints the table; `-- forward-1h` (or any
-//! case name) runs only that case. The IMU is at rest (exact increments of the Earth's
+//! part of a case's name, e.g. `soak`) runs only those cases. The IMU is at rest (exact increments of the Earth's
 //! rate and gravity, the same every sample) so that generating the log costs neither
 //! time nor memory; what the session keeps does not depend on the motion.
 
@@ -23,11 +23,16 @@ use std::process::Command;
 use std::time::Instant;
 
 /// A case: its name, hours of log, IMU rate [Hz], whether it smooths.
-const CASES: [(&str, f64, f64, bool); 4] = [
+/// The `soak` cases are issue "Reliability"'s: the forward filter over a day at 1 kHz,
+/// its peak at 1 h, 6 h and 24 h.
+const CASES: [(&str, f64, f64, bool); 7] = [
     ("forward-1h-200Hz", 1.0, 200.0, false),
     ("forward-10h-200Hz", 10.0, 200.0, false),
     ("smoother-1h-200Hz", 1.0, 200.0, true),
     ("smoother-10h-1kHz", 10.0, 1000.0, true),
+    ("soak-1h-1kHz", 1.0, 1000.0, false),
+    ("soak-6h-1kHz", 6.0, 1000.0, false),
+    ("soak-24h-1kHz", 24.0, 1000.0, false),
 ];
 
 /// The peak resident set of this process [kB].
