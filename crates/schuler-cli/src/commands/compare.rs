@@ -76,6 +76,16 @@ fn decimals(unit: &str) -> usize {
     if unit == "deg" { 5 } else { 4 }
 }
 
+/// A table cell: `d` decimals, or from 1e9 up the exponent form (an error that size
+/// is a broken input, and its hundreds of digits would say nothing more).
+fn cell(x: f64, d: usize) -> String {
+    if x.abs() >= 1e9 {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.d$}")
+    }
+}
+
 /// The report printed: what was matched, then one row per quantity.
 pub fn table(c: &Comparison) -> String {
     let m = &c.matching;
@@ -107,10 +117,15 @@ pub fn table(c: &Comparison) -> String {
     );
     for (Quantity { name, unit, .. }, q) in QUANTITIES.iter().zip(&c.stats.summaries) {
         let d = decimals(unit);
+        let cell = |x: f64| cell(x, d);
         let _ = writeln!(
             s,
-            "{name:<16} {unit:<4} {:>12.d$} {:>12.d$} {:>12.3} {:>12.d$} {:>12.d$}",
-            q.rms, q.max_abs, q.t_max_sow, q.p95_abs, q.mean
+            "{name:<16} {unit:<4} {:>12} {:>12} {:>12.3} {:>12} {:>12}",
+            cell(q.rms),
+            cell(q.max_abs),
+            q.t_max_sow,
+            cell(q.p95_abs),
+            cell(q.mean)
         );
     }
     let _ = writeln!(
