@@ -12,8 +12,10 @@
 //!
 //! Budget: [`DEFAULT_RUNS`] mutated inputs per target from a fixed seed, so `cargo
 //! test` is reproducible and quick. `SCHULER_FUZZ_SECONDS=600` runs each target for
-//! that long instead (and `SCHULER_FUZZ_SEED` moves the stream); a failing input is
-//! saved in the temporary directory and its path printed.
+//! that long instead (and `SCHULER_FUZZ_SEED` moves the stream;
+//! `SCHULER_FUZZ_TARGETS=imu,gnss` runs only the named parser targets, so a long campaign
+//! can be split over processes); a failing input is saved in the temporary directory and
+//! its path printed.
 
 use nalgebra::Vector3;
 use schuler::domain;
@@ -596,7 +598,17 @@ fn fuzz(target: &Target, dir: &Path) -> Vec<String> {
 #[test]
 fn parsers_keep_their_promises_on_mutated_inputs() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let failures: Vec<String> = TARGETS.iter().flat_map(|t| fuzz(t, dir.path())).collect();
+    let chosen = std::env::var("SCHULER_FUZZ_TARGETS").ok();
+    let wanted = |t: &&Target| {
+        chosen
+            .as_deref()
+            .is_none_or(|list| list.split(',').any(|name| name.trim() == t.name))
+    };
+    let failures: Vec<String> = TARGETS
+        .iter()
+        .filter(wanted)
+        .flat_map(|t| fuzz(t, dir.path()))
+        .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -20,6 +20,7 @@
 //! so the [`SplineTrajectory`] through the knots is the truth.
 
 use super::jet::{self, Jet, Scalar};
+use super::receivers::Interval;
 use super::spline::{Knot, SplineTrajectory};
 use crate::domain::{DomainError, HEIGHT, SPEED};
 use crate::earth::{EarthModel, Geodetic};
@@ -257,7 +258,8 @@ pub enum MotionError {
 }
 
 /// Longest motion a builder integrates by default [s]: a day, whose knots take 1.4 GB
-/// (152 + 8 bytes at 100 Hz); longer runs are soak tests, which repeat a shorter
+/// (152 + 8 bytes at 100 Hz) when kept for a trajectory in memory (a fed builder, as
+/// the simulator's, keeps none); longer runs are soak tests, which repeat a shorter
 /// motion ([`MotionBuilder::with_max_duration`] lifts the limit).
 pub const MAX_MOTION_DURATION: f64 = 24.0 * 3600.0;
 
@@ -268,7 +270,14 @@ pub struct MotionBuilder<E: EarthModel> {
     earth: E,
     x: [f64; 9],
     t: f64,
+    /// The knots kept for [`MotionBuilder::finish`]: all of them, unless the builder
+    /// is fed (then none: they went to the feed, and memory stays constant however
+    /// long the motion).
     knots: Vec<Knot>,
+    /// Whether the first knot (at the start) has been made.
+    started: bool,
+    /// The last knot's time [s] (within an ulp of `t`, which sums the durations).
+    last_knot_t: f64,
     pieces: usize,
     /// Who hears of the knots as they are made ([`MotionBuilder::feed`]).
     feed: FeedSlot,
@@ -277,7 +286,8 @@ pub struct MotionBuilder<E: EarthModel> {
 }
 
 /// A builder's [`KnotFeed`], if any. A clone (a trial integration) has none: its
-/// knots are not the motion's.
+/// knots are not the motion's (and a clone of a fed builder keeps only the knots made
+/// after the clone).
 #[derive(Default)]
 struct FeedSlot(Option<KnotFeed>);
 
@@ -321,6 +331,8 @@ impl<E: EarthModel> MotionBuilder<E> {
             x,
             t: start.t,
             knots: Vec::new(),
+            started: false,
+            last_knot_t: start.t,
             pieces: 0,
             feed: FeedSlot::default(),
             span: (start.t, MAX_MOTION_DURATION),
@@ -333,7 +345,8 @@ impl<E: EarthModel> MotionBuilder<E> {
         self
     }
 
-    /// Send every knot from now on to `feed` as well.
+    /// Send every knot from now on to `feed` instead of keeping it: the motion is then
+    /// ended by [`MotionBuilder::finish_fed`].
     pub fn feed(&mut self, feed: KnotFeed) {
         self.feed = FeedSlot(Some(feed));
     }
@@ -374,12 +387,12 @@ impl<E: EarthModel> MotionBuilder<E> {
         let n = (piece.duration / MAX_STEP).ceil().max(1.0) as usize;
         let h = piece.duration / n as f64;
         let mut x = self.x;
-        let mut knots = Vec::with_capacity(n + 1);
-        // Knots of this piece already sent to the feed.
-        let mut fed = 0;
+        // A fed builder holds one chunk at a time, an unfed one the whole piece.
+        let fed_builder = self.feed.0.is_some();
+        let mut knots = Vec::with_capacity(if fed_builder { FEED_CHUNK } else { n + 1 });
         // The derivative at each knot is also the first stage of the next step.
         let mut d1 = derivative_value(&self.earth, piece, 0.0, &x);
-        if self.knots.is_empty() {
+        if !self.started {
             knots.push(knot(&self.earth, piece, self.t, 0.0, &x, &d1));
         }
         for k in 0..n {
@@ -403,20 +416,34 @@ impl<E: EarthModel> MotionBuilder<E> {
             d1 = derivative_value(&self.earth, piece, tau1, &x);
             knots.push(knot(&self.earth, piece, self.t + tau1, tau1, &x, &d1));
             if let Some(feed) = self.feed.0.as_mut()
-                && (knots.len() - fed >= FEED_CHUNK || k + 1 == n)
+                && (knots.len() >= FEED_CHUNK || k + 1 == n)
             {
-                feed(&knots[fed..]);
-                fed = knots.len();
+                feed(&knots);
+                knots.clear();
             }
         }
         self.knots.extend(knots);
+        // The last knot's time, as the loop computed it.
+        self.last_knot_t = self.t + n as f64 * h;
+        self.started = true;
         self.x = x;
         self.t += piece.duration;
         self.pieces += 1;
         Ok(())
     }
 
-    /// The trajectory through everything pushed.
+    /// The span of a fed builder's motion (its knots went to the feed).
+    pub fn finish_fed(self) -> Result<Interval, MotionError> {
+        if self.pieces == 0 {
+            return Err(MotionError::Empty);
+        }
+        Ok(Interval {
+            start: self.span.0,
+            end: self.last_knot_t,
+        })
+    }
+
+    /// The trajectory through everything pushed (an unfed builder's).
     pub fn finish(self) -> Result<SplineTrajectory, MotionError> {
         if self.pieces == 0 {
             return Err(MotionError::Empty);
@@ -513,6 +540,38 @@ mod tests {
             v_n: Vector3::new(20.0, 0.0, 0.0),
             attitude: Euler::default(),
         }
+    }
+
+    /// A fed builder sends its knots and keeps none (its memory does not grow with
+    /// the motion), and what it sends is the unfed builder's trajectory, bit for bit,
+    /// over exactly the span it reports.
+    #[test]
+    fn a_fed_builder_sends_every_knot_and_keeps_none() {
+        let pieces = [
+            Piece::hold(25.0),
+            Piece {
+                d_vel: [5.0, 0.0, 0.0],
+                shape: Shape::Bump,
+                ..Piece::hold(12.3)
+            },
+        ];
+        let sent = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let to = std::sync::Arc::clone(&sent);
+        let mut fed = MotionBuilder::new(Wgs84, &start());
+        fed.feed(Box::new(move |k| {
+            to.lock().expect("lock").extend_from_slice(k)
+        }));
+        let mut unfed = MotionBuilder::new(Wgs84, &start());
+        for p in &pieces {
+            fed.push(p).expect("fed");
+            unfed.push(p).expect("unfed");
+            assert!(fed.knots.is_empty());
+        }
+        let span = fed.finish_fed().expect("span");
+        let traj = unfed.finish().expect("trajectory");
+        let sent = std::mem::take(&mut *sent.lock().expect("lock"));
+        assert!(SplineTrajectory::new(sent).expect("knots") == traj);
+        assert_eq!((span.start, span.end), (traj.start(), traj.end()));
     }
 
     /// Issue "Reliability"'s reproducers, which aborted on allocation or ran for ever:

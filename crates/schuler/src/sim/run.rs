@@ -18,7 +18,7 @@ use crate::earth::{EarthModel, Sphere, Wgs84};
 use crate::imu::ImuSample;
 use crate::nav::NavState;
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::collections::VecDeque;
 use std::sync::{Condvar, Mutex};
 
 /// The Earth model of a scenario.
@@ -78,7 +78,14 @@ impl ScenarioSpec {
         &self,
         earth: E,
     ) -> Result<(SplineTrajectory, Vec<Interval>), ScenarioError> {
-        Ok((self.trajectory_fed(earth, None)?, self.motion_outages()))
+        let trajectory = match &self.imported {
+            Some(def) => self
+                .imported_builder(earth, def, None)?
+                .finish()
+                .map_err(imported_error)?,
+            None => self.motion_spec()?.build(earth)?,
+        };
+        Ok((trajectory, self.motion_outages()))
     }
 
     /// The GNSS outages the motion file adds (none without one).
@@ -97,45 +104,58 @@ impl ScenarioSpec {
             .collect()
     }
 
-    /// [`ScenarioSpec::trajectory`] without the outages, sending the knots to `feed`
-    /// as they are made.
+    /// The motion's span, with its knots sent to `feed` as they are made and not kept
+    /// (constant memory however long the motion).
     pub fn trajectory_fed<E: EarthModel>(
         &self,
         earth: E,
-        feed: Option<KnotFeed>,
-    ) -> Result<SplineTrajectory, ScenarioError> {
-        if let Some(def) = &self.imported {
-            let pieces = def.pieces().0;
-            let start = Start {
-                t: self.start.as_ref().map_or(0.0, |s| s.time),
-                pos: def.pos,
-                v_n: def.attitude.to_dcm() * def.v_body,
-                attitude: def.attitude,
-            };
-            let mut b = MotionBuilder::new(earth, &start);
-            if let Some(feed) = feed {
-                b.feed(feed);
-            }
-            for (i, p) in pieces.iter().enumerate() {
-                b.push(p).map_err(|source| ScenarioError::Motion {
-                    key: format!("motion_csv piece {i}"),
-                    source,
-                })?;
-            }
-            return b.finish().map_err(|source| ScenarioError::Motion {
-                key: "motion_csv".into(),
-                source,
-            });
+        feed: KnotFeed,
+    ) -> Result<Interval, ScenarioError> {
+        match &self.imported {
+            Some(def) => self
+                .imported_builder(earth, def, Some(feed))?
+                .finish_fed()
+                .map_err(imported_error),
+            None => self.motion_spec()?.build_fed(earth, feed),
         }
+    }
+
+    /// A builder with the motion file's pieces pushed.
+    fn imported_builder<E: EarthModel>(
+        &self,
+        earth: E,
+        def: &MotionDefinition,
+        feed: Option<KnotFeed>,
+    ) -> Result<MotionBuilder<E>, ScenarioError> {
+        let start = Start {
+            t: self.start.as_ref().map_or(0.0, |s| s.time),
+            pos: def.pos,
+            v_n: def.attitude.to_dcm() * def.v_body,
+            attitude: def.attitude,
+        };
+        let mut b = MotionBuilder::new(earth, &start);
+        if let Some(feed) = feed {
+            b.feed(feed);
+        }
+        for (i, p) in def.pieces().0.iter().enumerate() {
+            b.push(p).map_err(|source| ScenarioError::Motion {
+                key: format!("motion_csv piece {i}"),
+                source,
+            })?;
+        }
+        Ok(b)
+    }
+
+    /// The scripted motion (`start` and `motion`).
+    fn motion_spec(&self) -> Result<MotionSpec, ScenarioError> {
         let start = self.start.clone().ok_or_else(|| ScenarioError::Value {
             key: "start".into(),
             message: "missing: give [start] and [[motion]], or motion_csv".into(),
         })?;
-        let spec = MotionSpec {
+        Ok(MotionSpec {
             start,
             motion: self.motion.clone(),
-        };
-        spec.build_fed(earth, feed)
+        })
     }
 }
 
@@ -240,6 +260,14 @@ pub enum SimError {
     /// The sink failed to write.
     #[error("writing the simulated data failed")]
     Io(#[from] std::io::Error),
+}
+
+/// A motion file's error at its end.
+fn imported_error(source: super::motion::MotionError) -> ScenarioError {
+    ScenarioError::Motion {
+        key: "motion_csv".into(),
+        source,
+    }
 }
 
 /// What a simulation produced.
@@ -489,14 +517,47 @@ impl<A, B> Drop for FailGuard<'_, A, B> {
     }
 }
 
-/// The knots the builder has made so far, shared with the workers.
-#[derive(Default)]
+/// The knots the builder has made and the workers may still need, shared with them.
 struct Built {
-    knots: Vec<Knot>,
+    /// From the last knot at or before the oldest window a worker may still ask for,
+    /// to the builder's head.
+    knots: VecDeque<Knot>,
+    /// The first knot's time [s], once made (its knot may be gone).
+    first: Option<f64>,
     /// Set when the build is over: the trajectory's end time, or `None` if it failed
     /// (or a worker did: nobody waits any more).
     end: Option<Option<f64>>,
+    /// Blocks claimed whose window has not been taken yet, with the window's start.
+    claimed: Vec<(u64, f64)>,
+    /// The next block to claim, and its window's start once the first claim told how
+    /// a block's start is found.
+    next: u64,
+    next_start: Option<f64>,
+    /// The latest time a worker has waited for [s]: the builder goes on past
+    /// [`KNOTS_AHEAD`] until its head is beyond it.
+    wanted: f64,
+    /// The most knots held at once (for the test of the bound).
+    peak: usize,
 }
+
+impl Default for Built {
+    fn default() -> Self {
+        Self {
+            knots: VecDeque::new(),
+            first: None,
+            end: None,
+            claimed: Vec::new(),
+            next: 0,
+            next_start: None,
+            wanted: f64::NEG_INFINITY,
+            peak: 0,
+        }
+    }
+}
+
+/// Knots the builder keeps ahead of the workers before it waits for them (80 s of
+/// motion at the longest step, 1.2 MB): what bounds a simulation's memory.
+const KNOTS_AHEAD: usize = 8 * super::motion::FEED_CHUNK;
 
 /// What a worker needs for a block: the knots around its samples, or the news that
 /// the build ended first.
@@ -526,8 +587,29 @@ impl Feed {
             .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    fn wait<'a>(&self, g: std::sync::MutexGuard<'a, Built>) -> std::sync::MutexGuard<'a, Built> {
+        self.more
+            .wait(g)
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// Take `knots` from the builder; wait first while it holds [`KNOTS_AHEAD`] and
+    /// has made every knot a worker waits for (so a worker always gets its window, and
+    /// memory stays bounded when the workers are slower than the builder).
     fn push(&self, knots: &[Knot]) {
-        self.lock().knots.extend_from_slice(knots);
+        let mut built = self.lock();
+        while built.end.is_none()
+            && built.knots.len() >= KNOTS_AHEAD
+            && built.knots.back().is_some_and(|k| k.t > built.wanted)
+        {
+            built = self.wait(built);
+        }
+        if built.first.is_none() {
+            built.first = knots.first().map(|k| k.t);
+        }
+        built.knots.extend(knots.iter().cloned());
+        built.peak = built.peak.max(built.knots.len());
+        drop(built);
         self.more.notify_all();
     }
 
@@ -545,17 +627,44 @@ impl Feed {
     fn start(&self) -> Option<f64> {
         let mut built = self.lock();
         loop {
-            if let Some(k) = built.knots.first() {
-                return Some(k.t);
+            if built.first.is_some() {
+                return built.first;
             }
             if built.end.is_some() {
                 return None;
             }
-            built = self
-                .more
-                .wait(built)
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            built = self.wait(built);
         }
+    }
+
+    /// The next block, whose window starts at `window_start(block)` [s] (increasing
+    /// with the block): its knots are kept until [`Feed::taken`].
+    fn claim(&self, window_start: impl Fn(u64) -> f64) -> u64 {
+        let mut built = self.lock();
+        let k = built.next;
+        built.claimed.push((k, window_start(k)));
+        built.next = k + 1;
+        built.next_start = Some(window_start(k + 1));
+        k
+    }
+
+    /// Block `k`'s window has been taken (or is not needed): drop the knots no
+    /// claimed or future block needs, and let the builder go on.
+    fn taken(&self, k: u64) {
+        let mut built = self.lock();
+        built.claimed.retain(|&(b, _)| b != k);
+        let oldest = built
+            .claimed
+            .iter()
+            .map(|&(_, a)| a)
+            .chain(built.next_start)
+            .fold(f64::INFINITY, f64::min);
+        // A window starting at `oldest` begins at the last knot at or before it.
+        while built.knots.get(1).is_some_and(|k| k.t <= oldest) {
+            built.knots.pop_front();
+        }
+        drop(built);
+        self.more.notify_all();
     }
 
     /// The knots covering `[a, b]`: from the last at or before `a` to the first after
@@ -568,18 +677,17 @@ impl Feed {
                 Some(None) => return Window::Failed,
                 Some(Some(end)) if b > end => return Window::Ended(end),
                 Some(Some(_)) => break,
-                None if built.knots.last().is_some_and(|k| k.t > b) => break,
+                None if built.knots.back().is_some_and(|k| k.t > b) => break,
                 None => {}
             }
-            built = self
-                .more
-                .wait(built)
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            built.wanted = built.wanted.max(b);
+            self.more.notify_all();
+            built = self.wait(built);
         }
         let knots = &built.knots;
         let from = knots.partition_point(|k| k.t <= a).saturating_sub(1);
         let to = knots.partition_point(|k| k.t <= b).min(knots.len() - 1);
-        match SplineTrajectory::new(knots[from..=to].to_vec()) {
+        match SplineTrajectory::new(knots.range(from..=to).cloned().collect()) {
             Ok(traj) => Window::Knots(traj),
             // The builder's knots always form a trajectory; a failure ends the run.
             Err(_) => Window::Failed,
@@ -631,7 +739,6 @@ impl Run {
         });
         let writer = Turns::new((write, None::<std::io::Error>));
         let feed = std::sync::Arc::new(Feed::default());
-        let next_block = AtomicU64::new(0);
         let worker = || {
             let mut guard = FailGuard {
                 sensors: &sensors,
@@ -643,27 +750,28 @@ impl Run {
                 return;
             };
             let (mut block, mut text) = (SimBlock::default(), T::default());
+            // Sample k ends at t0 + k dt; the first integrates from the one before.
+            let time = |k: u64| t0 + k as f64 * dt;
             loop {
-                let k = next_block.fetch_add(1, Ordering::Relaxed);
+                let k = feed.claim(|k| time(k * self.block) - dt);
                 let k0 = k * self.block;
                 let mut k1 = k0 + self.block;
-                // Sample k ends at t0 + k dt; the first integrates from the one before.
-                let time = |k: u64| t0 + k as f64 * dt;
-                let traj = match feed.window(time(k0) - dt, time(k1 - 1)) {
-                    Window::Knots(traj) => traj,
+                let window = match feed.window(time(k0) - dt, time(k1 - 1)) {
                     Window::Ended(t1) => {
                         let n = ((t1 - t0) / dt + 1e-9).floor() as u64;
                         if k0 > n {
+                            feed.taken(k);
                             break;
                         }
                         k1 = k1.min(n + 1);
                         // The last sample may end up to 1e-9 dt past the end.
-                        match feed.window(time(k0) - dt, time(k1 - 1).min(t1)) {
-                            Window::Knots(traj) => traj,
-                            _ => return,
-                        }
+                        feed.window(time(k0) - dt, time(k1 - 1).min(t1))
                     }
-                    Window::Failed => return,
+                    other => other,
+                };
+                feed.taken(k);
+                let Window::Knots(traj) = window else {
+                    return;
                 };
                 super::exact::exact_block(&earth, &traj, t0, dt, k0, k1, &mut block.imu);
                 if sensors
@@ -696,9 +804,8 @@ impl Run {
                 // Should the build panic, the workers waiting for its knots are let go.
                 let _ends = EndsFeed(&feed);
                 let to_workers = std::sync::Arc::clone(&feed);
-                let result =
-                    spec.trajectory_fed(earth, Some(Box::new(move |k| to_workers.push(k))));
-                feed.end(result.as_ref().ok().map(SplineTrajectory::end));
+                let result = spec.trajectory_fed(earth, Box::new(move |k| to_workers.push(k)));
+                feed.end(result.as_ref().ok().map(|span| span.end));
                 result
             });
             let others: Vec<_> = (1..self.workers).map(|_| scope.spawn(worker)).collect();
@@ -710,12 +817,12 @@ impl Run {
                 .join()
                 .unwrap_or_else(|e| std::panic::resume_unwind(e))
         });
-        let traj = built?;
+        let span = built?;
         if let (_, Some(e)) = writer.into_data() {
             return Err(SimError::Io(e));
         }
         let mut summary = sensors.into_data().summary;
-        (summary.t0, summary.t1) = (traj.start(), traj.end());
+        (summary.t0, summary.t1) = (span.start, span.end);
         Ok(summary)
     }
 }
@@ -875,6 +982,62 @@ noise = "0.5 m"
                 "{run:?} differs from one worker"
             );
         }
+    }
+
+    /// However far the builder could run ahead of a worker, the feed holds at most
+    /// [`KNOTS_AHEAD`] knots and one chunk more (the builder stops on the chunk that
+    /// passes the bound unless a worker waits for knots beyond its head, and a window
+    /// here spans one chunk), while every window is the same knots as the whole list
+    /// gives: the memory of a simulation does not grow with its length.
+    #[test]
+    fn the_feed_holds_a_bounded_number_of_knots() {
+        use super::super::motion::FEED_CHUNK;
+        let feed = Feed::default();
+        let knot = |i: usize| Knot {
+            t: i as f64 * 0.01,
+            value: [i as f64; 6],
+            rate: [0.0; 6],
+            accel: [0.0; 6],
+        };
+        let chunks = 60;
+        let all: Vec<Knot> = (0..chunks * FEED_CHUNK).map(knot).collect();
+        let end = all[all.len() - 1].t;
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                for chunk in all.chunks(FEED_CHUNK) {
+                    feed.push(chunk);
+                }
+                feed.end(Some(end));
+            });
+            // The worker starts late: the builder has run as far ahead as it may.
+            let mut built = feed.lock();
+            while built.knots.len() < KNOTS_AHEAD {
+                built = feed.wait(built);
+            }
+            drop(built);
+            // Blocks of 10 s, each window from 0.01 s before the block's start.
+            let start = |k: u64| k as f64 * 10.0 - 0.01;
+            loop {
+                let k = feed.claim(start);
+                let (a, b) = (start(k), start(k) + 10.0);
+                if b > end {
+                    feed.taken(k);
+                    break;
+                }
+                let window = feed.window(a, b);
+                feed.taken(k);
+                let Window::Knots(traj) = window else {
+                    panic!("block {k}: no window");
+                };
+                let from = all.partition_point(|x| x.t <= a).saturating_sub(1);
+                let to = all.partition_point(|x| x.t <= b).min(all.len() - 1);
+                let expected = SplineTrajectory::new(all[from..=to].to_vec()).expect("knots");
+                assert!(traj == expected, "block {k}: other knots");
+            }
+        });
+        let peak = feed.lock().peak;
+        assert!(peak <= KNOTS_AHEAD + FEED_CHUNK, "{peak} knots held");
+        assert!(peak >= KNOTS_AHEAD, "{peak}: the builder was not held");
     }
 
     /// A write that fails stops every worker and is returned; nothing is written after

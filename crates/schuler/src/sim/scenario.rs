@@ -27,6 +27,7 @@
 //! why.
 
 use super::motion::{KnotFeed, MotionBuilder, MotionError, Piece, Shape, Start, VelocityAxes};
+use super::receivers::Interval;
 use super::spline::SplineTrajectory;
 use crate::earth::{EarthModel, Geodetic};
 use crate::rotation::{Euler, wrap_pi};
@@ -839,15 +840,29 @@ fn compile<E: EarthModel>(
 impl MotionSpec {
     /// Compile and integrate the motion on `earth`.
     pub fn build<E: EarthModel>(&self, earth: E) -> Result<SplineTrajectory, ScenarioError> {
-        self.build_fed(earth, None)
+        self.builder(earth, None)?
+            .finish()
+            .map_err(Self::motion_error)
     }
 
-    /// [`MotionSpec::build`], sending the knots to `feed` as they are made.
+    /// [`MotionSpec::build`] with the knots sent to `feed` as they are made and not
+    /// kept (constant memory): the motion's span.
     pub fn build_fed<E: EarthModel>(
         &self,
         earth: E,
+        feed: KnotFeed,
+    ) -> Result<Interval, ScenarioError> {
+        self.builder(earth, Some(feed))?
+            .finish_fed()
+            .map_err(Self::motion_error)
+    }
+
+    /// A builder with every segment pushed.
+    fn builder<E: EarthModel>(
+        &self,
+        earth: E,
         feed: Option<KnotFeed>,
-    ) -> Result<SplineTrajectory, ScenarioError> {
+    ) -> Result<MotionBuilder<E>, ScenarioError> {
         let start = self.start.resolve()?;
         if self.motion.is_empty() {
             return Err(ScenarioError::value(
@@ -862,10 +877,14 @@ impl MotionSpec {
         for (i, seg) in self.motion.iter().enumerate() {
             compile(&mut b, &format!("motion[{i}]"), seg)?;
         }
-        b.finish().map_err(|source| ScenarioError::Motion {
+        Ok(b)
+    }
+
+    fn motion_error(source: MotionError) -> ScenarioError {
+        ScenarioError::Motion {
             key: "motion".into(),
             source,
-        })
+        }
     }
 }
 
