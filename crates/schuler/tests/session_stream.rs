@@ -356,3 +356,48 @@ fn the_gate_reset_refuses_impossible_fixes() {
     assert!(r.iter().all(|&(t, nis)| t > 110.0 && nis < 100.0), "{r:?}");
     assert_eq!(impossible.summary.counts.rejected, 10);
 }
+
+/// A truth pushed in step with the samples (before each sample, its epochs up to 1 s
+/// past the sample and the first one after, as `schuler nav` streams `--truth`) gives
+/// the snapshots of the whole truth given at the start, NEES included, bit for bit;
+/// the snapshots taken as they come are those a finished session would hand over.
+/// The truth is at 3 Hz, offset from the once-a-second snapshots, so most NEES use an
+/// interpolated truth, and it starts before and ends after the samples.
+#[test]
+fn a_streamed_truth_gives_the_snapshots_of_the_whole_truth() {
+    use schuler::analysis::errors::NavRecord;
+    use schuler::session::Snapshot;
+    let log = log();
+    let traj = Maneuvering::flight(Geodetic::from_degrees(45.0, 7.0, 300.0));
+    let truth: Vec<NavRecord> = (0..3 * SECONDS + 12)
+        .map(|k| NavRecord::from(&analytic::state(&Wgs84, &traj, k as f64 / 3.0 - 0.9)))
+        .collect();
+    let new = || Session::new(Wgs84, config(0.0, log.noise), log.start).expect("valid");
+    let mut whole = new().with_truth(truth.clone());
+    let mut streamed = new();
+    for a in &log.aids {
+        whole.push(*a).expect("aid");
+        streamed.push(*a).expect("aid");
+    }
+    let (mut next, mut taken): (usize, Vec<Snapshot>) = (0, Vec::new());
+    for s in &log.imu {
+        // Until the last epoch pushed is past the horizon.
+        while let Some(r) = truth.get(next) {
+            if next > 0 && truth[next - 1].t_sow > s.t + 1.0 {
+                break;
+            }
+            streamed.push_truth(*r);
+            next += 1;
+        }
+        whole.push_imu(*s).expect("sample");
+        streamed.push_imu(*s).expect("sample");
+        taken.extend(streamed.snapshots());
+    }
+    let whole = whole.finish().expect("finish").snapshots;
+    taken.extend(streamed.finish().expect("finish").snapshots);
+    assert!(next < truth.len(), "the truth's last epochs stay unread");
+    assert_eq!(whole.len(), SECONDS + 1);
+    let with_nees = whole.iter().filter(|s| s.nees.is_some()).count();
+    assert_eq!(with_nees, whole.len(), "every snapshot inside the truth");
+    assert_eq!(taken, whole);
+}

@@ -58,6 +58,11 @@ impl Records {
         self.spilled + self.tail.len() / self.width
     }
 
+    /// Values held in memory (at most about the budget, however many records).
+    pub fn in_memory(&self) -> usize {
+        self.tail.len()
+    }
+
     /// Whether there is no record.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
@@ -120,6 +125,31 @@ impl Records {
         }
         let mut f = self.file_at(k)?;
         read_values(&mut f, out)
+    }
+
+    /// Records from `k` on into `out` (a multiple of the width), as many as fit and
+    /// lie on the same side of the memory/file boundary; returns how many (0: `k` is
+    /// past the last). One read for a block, where [`Records::read`] costs one per
+    /// record.
+    pub fn read_block(&self, k: usize, out: &mut [f64]) -> Result<usize, SpillError> {
+        let w = self.width;
+        let room = out.len() / w;
+        if k >= self.len() || room == 0 {
+            return Ok(0);
+        }
+        let n = if k < self.spilled {
+            room.min(self.spilled - k)
+        } else {
+            room.min(self.len() - k)
+        };
+        if k >= self.spilled {
+            let o = (k - self.spilled) * w;
+            out[..n * w].copy_from_slice(&self.tail[o..o + n * w]);
+        } else {
+            let mut f = self.file_at(k)?;
+            read_values(&mut f, &mut out[..n * w])?;
+        }
+        Ok(n)
     }
 
     /// The records from the first, in order.
@@ -248,6 +278,33 @@ mod tests {
                     k += 1;
                 }
                 assert_eq!(k, 50, "{name}, budget {budget}");
+            }
+        }
+    }
+
+    #[test]
+    fn blocks_come_back_bit_for_bit_across_the_file_and_memory() {
+        for budget in [3, 7, 1000] {
+            let mut r = Records::new(3, budget);
+            for k in 0..50 {
+                r.push(&record(k));
+            }
+            assert!(r.in_memory() <= budget, "budget {budget}");
+            // A block of 4 records (and a ragged 13 values: 4 records and a rest).
+            for size in [12, 13] {
+                let mut out = vec![0.0; size];
+                let mut k = 0;
+                loop {
+                    let n = r.read_block(k, &mut out).expect("block");
+                    if n == 0 {
+                        break;
+                    }
+                    for (i, got) in out.chunks_exact(3).take(n).enumerate() {
+                        assert!(same(got, &record(k + i)), "budget {budget}, {}", k + i);
+                    }
+                    k += n;
+                }
+                assert_eq!(k, 50, "budget {budget}");
             }
         }
     }

@@ -213,6 +213,29 @@ struct Loop {
     failure: Option<SessionError>,
 }
 
+impl Aid {
+    /// The error [`Session::push`] gives this aid, if any: times not finite, or a
+    /// value outside its domain (so that a front end can check its aids before it
+    /// pushes them).
+    pub fn validate(&self) -> Result<(), SessionError> {
+        if !self.times_valid() {
+            return Err(SessionError::AidNotFinite {
+                t: self.t(),
+                kind: self.kind(),
+            });
+        }
+        if let Some((field, error)) = self.out_of_domain() {
+            return Err(SessionError::AidOutOfDomain {
+                t: self.t(),
+                kind: self.kind(),
+                field,
+                error,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// A navigation session (module doc).
 #[derive(Debug, Clone)]
 pub struct Session<E: EarthModel> {
@@ -278,6 +301,17 @@ impl<E: EarthModel> Session<E> {
         self
     }
 
+    /// Appends an epoch to the truth the snapshots' NEES is computed against (times
+    /// increasing, after those of [`Session::with_truth`]): a front end streaming a
+    /// truth file pushes each epoch before the samples that reach its time, and one
+    /// epoch past them, so that the session holds a window of the truth, not all of
+    /// it. Without snapshots it is not kept.
+    pub fn push_truth(&mut self, r: NavRecord) {
+        if let Some(taker) = self.run.snapshots.as_mut() {
+            taker.push_truth(r);
+        }
+    }
+
     /// The configuration.
     pub fn config(&self) -> &SessionConfig {
         &self.run.cfg
@@ -331,20 +365,7 @@ impl<E: EarthModel> Session<E> {
 
     /// Push an aid (in arrival order; see [`aid`] for when it is late).
     pub fn push(&mut self, aid: Aid) -> Result<(), SessionError> {
-        if !aid.times_valid() {
-            return Err(SessionError::AidNotFinite {
-                t: aid.t(),
-                kind: aid.kind(),
-            });
-        }
-        if let Some((field, error)) = aid.out_of_domain() {
-            return Err(SessionError::AidOutOfDomain {
-                t: aid.t(),
-                kind: aid.kind(),
-                field,
-                error,
-            });
-        }
+        aid.validate()?;
         if let Some((t_done, dt)) = self.run.done
             && aid::is_late(&aid, t_done, dt)
         {
@@ -368,6 +389,19 @@ impl<E: EarthModel> Session<E> {
             None => self.run.queues.push(aid),
         }
         Ok(())
+    }
+
+    /// The filter's snapshots so far, oldest first, taken out of the session (so that
+    /// a long run that takes them as they come keeps none; those not taken are in
+    /// [`Finished::snapshots`]).
+    pub fn snapshots(&mut self) -> std::vec::IntoIter<Snapshot> {
+        let taken = self
+            .run
+            .snapshots
+            .as_mut()
+            .map(|s| std::mem::take(&mut s.taken))
+            .unwrap_or_default();
+        taken.into_iter()
     }
 
     /// The output epochs so far, oldest first (taken out of the session as the

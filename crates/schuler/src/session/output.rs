@@ -4,7 +4,7 @@
 
 use super::config::MechanizationKind;
 use crate::analysis::consistency::normalized_squared;
-use crate::analysis::errors::{NavRecord, TruthAt, TruthCursor, errors_between};
+use crate::analysis::errors::{NavRecord, TIME_TOLERANCE_S, TruthAt, TruthCursor, errors_between};
 use crate::earth::EarthModel;
 use crate::filter::integration::{Innovation, Rejected, Skipped};
 use crate::filter::kalman::std3;
@@ -12,6 +12,7 @@ use crate::filter::measurement::Kind;
 use crate::filter::{Integrator, Layout, SensorEstimates};
 use crate::nav::{ErrorFrame, NavState};
 use nalgebra::{Matrix3, Vector3};
+use std::collections::VecDeque;
 
 /// One output epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,10 +180,16 @@ pub struct Snapshot {
 }
 
 /// Takes a [`Snapshot`] at a cadence, with NEES against a truth when it has one.
+///
+/// The truth is held from the epoch at or before the last snapshot on: the epochs
+/// behind it are dropped as the snapshots pass them, so a truth pushed ahead of the
+/// samples ([`super::Session::push_truth`]) costs a window, not the whole file. The
+/// truth at a time is then [`TruthCursor`]'s on the whole truth: the epoch within
+/// [`TIME_TOLERANCE_S`], else interpolated between the two around it, provided an
+/// epoch after the time is already held (or the truth has ended).
 #[derive(Debug, Clone)]
 pub(crate) struct SnapshotTaker {
-    truth: Vec<NavRecord>,
-    cursor: TruthCursor,
+    truth: VecDeque<NavRecord>,
     cadence: Decimator,
     pub taken: Vec<Snapshot>,
 }
@@ -190,11 +197,24 @@ pub(crate) struct SnapshotTaker {
 impl SnapshotTaker {
     pub fn new(rate: f64, truth: Vec<NavRecord>) -> Self {
         Self {
-            truth,
-            cursor: TruthCursor::default(),
+            truth: truth.into(),
             cadence: Decimator::new(Some(rate)),
             taken: Vec::new(),
         }
+    }
+
+    /// Appends a truth epoch (after the last one held).
+    pub fn push_truth(&mut self, r: NavRecord) {
+        self.truth.push_back(r);
+    }
+
+    /// The truth at `t` (times that do not decrease), the epochs before the one at
+    /// or before `t` dropped.
+    fn truth_at(&mut self, t: f64) -> TruthAt {
+        while self.truth.len() >= 2 && self.truth[1].t_sow <= t + TIME_TOLERANCE_S {
+            self.truth.pop_front();
+        }
+        TruthCursor::default().at(self.truth.make_contiguous(), t)
     }
 
     /// After a sample ending at `t` after `dt`: a snapshot at the first epoch of each
@@ -215,7 +235,7 @@ impl SnapshotTaker {
         let nees = if self.truth.is_empty() {
             None
         } else {
-            match self.cursor.at(&self.truth, state.t) {
+            match self.truth_at(state.t) {
                 TruthAt::Exact(truth) | TruthAt::Interpolated(truth, _) => {
                     let e = errors_between(earth, &state, &(&truth).into());
                     let [pp, pv, pa]: [Matrix3<f64>; 3] = integ.nav_covariance();
