@@ -16,8 +16,9 @@ use schuler::units::{Dimension, parse_as_or_si};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The bag flags of `schuler nav`.
-#[derive(clap::Args, Debug, Default, Clone)]
+/// The bag flags of `schuler nav`, also the keys of `--config` with underscores
+/// (`bag = "run.mcap"`, `imu_topic = "/imu/data"`, `out_bag = "nav.mcap"`; flags win).
+#[derive(clap::Args, Debug, Default, Clone, PartialEq)]
 pub struct BagArgs {
     /// A ROS 2 bag (.mcap file or rosbag2 directory) as the input: sensor_msgs/Imu,
     /// NavSatFix, FluidPressure, geometry_msgs/TwistWithCovarianceStamped (GNSS
@@ -39,10 +40,40 @@ pub struct BagArgs {
     /// The Odometry topic (forward speed), when several.
     #[arg(long, value_name = "TOPIC")]
     pub odom_topic: Option<String>,
+    /// GPS - UTC [s] for a bag whose header stamps are UNIX time (default: the
+    /// leap seconds of each stamp's date, 18 since 2017-01-01).
+    #[arg(long, value_name = "SECONDS")]
+    pub leap_seconds: Option<i64>,
     /// Also write the result as a ROS 2 bag (MCAP): nav_msgs/Odometry (pose in ENU),
     /// sensor_msgs/NavSatFix and the sensor-error estimates (any IMU input).
     #[arg(long, value_name = "FILE.mcap")]
     pub out_bag: Option<PathBuf>,
+}
+
+impl BagArgs {
+    /// `self` (the flags) with what they lack taken from `other` (the configuration).
+    pub fn or(self, other: BagArgs) -> BagArgs {
+        BagArgs {
+            bag: self.bag.or(other.bag),
+            imu_topic: self.imu_topic.or(other.imu_topic),
+            gnss_topic: self.gnss_topic.or(other.gnss_topic),
+            gnss_vel_topic: self.gnss_vel_topic.or(other.gnss_vel_topic),
+            baro_topic: self.baro_topic.or(other.baro_topic),
+            odom_topic: self.odom_topic.or(other.odom_topic),
+            out_bag: self.out_bag.or(other.out_bag),
+            leap_seconds: self.leap_seconds.or(other.leap_seconds),
+        }
+    }
+
+    /// The paths relative to `base` (a configuration file's folder).
+    pub fn relative_to(mut self, base: &std::path::Path) -> BagArgs {
+        for p in [&mut self.bag, &mut self.out_bag].into_iter().flatten() {
+            if p.is_relative() {
+                *p = base.join(&*p);
+            }
+        }
+        self
+    }
 }
 
 /// The reading options of the run's flags.
@@ -75,11 +106,18 @@ fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<BagR
         t_end: read.t_end,
         default_gnss_std,
         default_vel_std,
+        leap_seconds: args.leap_seconds,
+        check_layout: read.check_layout,
     })
 }
 
-/// The chosen topics and what was found, on stderr.
+/// The chosen topics, the clock and what was found, on stderr.
 fn describe(p: &BagPlan) {
+    eprintln!(
+        "{}: {}",
+        p.path.display(),
+        crate::bag::clock::describe(&p.clock)
+    );
     for kind in Kind::ALL {
         if let Some(t) = p.topic(kind) {
             eprintln!("{}: {} from {t}", p.path.display(), kind.type_name());
@@ -104,15 +142,53 @@ fn describe(p: &BagPlan) {
     }
 }
 
+/// The barometer's and the odometer's noise from the messages' variances, where they
+/// give them and neither a flag nor a file of the same kind does (as the IMU's
+/// covariances give ARW and VRW); printed.
+fn noise_of_variances(plan: &mut NavPlan, bag: &BagPlan) {
+    let a = &mut plan.aiding;
+    let path = bag.path.display();
+    if let Some(std) = bag.aids.baro_std
+        && a.baro.is_none()
+        && a.baro_std.is_none()
+    {
+        a.baro_std = Some(std.to_string());
+        eprintln!(
+            "{path}: barometer noise from its pressure variances: {std} m (--baro-std overrides)"
+        );
+    }
+    if let Some(std) = bag.aids.odometer_std
+        && a.odometer.is_none()
+        && a.odometer_std.is_none()
+    {
+        a.odometer_std = Some(std.to_string());
+        eprintln!(
+            "{path}: odometer noise from its twist covariances: {std} m/s (--odometer-std overrides)"
+        );
+    }
+}
+
 /// `schuler nav --bag`.
-pub fn run(mut plan: NavPlan, args: &BagArgs) -> Result<()> {
+pub fn run(mut plan: NavPlan) -> Result<()> {
+    let args = plan.bag.clone();
     let Some(path) = &args.bag else {
         bail!("--bag is missing");
     };
     let started = Instant::now();
-    let options = read_options(&plan, args, plan.axes_given)?;
+    let options = read_options(&plan, &args, plan.axes_given)?;
     let bag = plan_bag(path, &options)?;
     describe(&bag);
+    noise_of_variances(&mut plan, &bag);
+    if let Some(week) = bag.clock.week() {
+        let given = plan.settings.week;
+        if given != 0 && given != week {
+            bail!("--week {given}: the bag's UNIX stamps are in GPS week {week}");
+        }
+        plan.settings.week = week;
+    }
+    if let Some(out) = plan.settings.out_bag.as_mut() {
+        out.clock = bag.clock;
+    }
     plan.aiding.bag = Some(bag.aids.clone());
     let mut noise = filter_grade(&plan).noise()?;
     if let Some((arw, vrw)) = bag.imu_noise {
@@ -131,6 +207,14 @@ pub fn run(mut plan: NavPlan, args: &BagArgs) -> Result<()> {
     let bar = ProgressBar::hidden();
     let summary = navigate_samples(&plan, &mut aiding, &mut samples, &bar, |_| {})?;
     let secs = started.elapsed().as_secs_f64();
+    let gaps = samples.gaps();
+    if !gaps.is_empty() {
+        eprintln!(
+            "warning: {}: topic {}: {gaps}",
+            path.display(),
+            samples.topic()
+        );
+    }
     print_summary(&plan, aiding.as_ref(), &summary, secs)
 }
 

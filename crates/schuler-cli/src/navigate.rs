@@ -46,7 +46,7 @@ pub struct NavSettings {
     /// The mechanization and its hand-over latitudes.
     pub mechanization: MechanizationConfig,
     /// The result bag to write (`--out-bag`), if any.
-    pub out_bag: Option<PathBuf>,
+    pub out_bag: Option<crate::bag::output::OutBag>,
 }
 
 impl NavSettings {
@@ -149,8 +149,8 @@ fn outputs<E: EarthModel>(
     if !names.start_epoch {
         outputs = outputs.without_start_epoch();
     }
-    if let Some(path) = &settings.out_bag {
-        outputs.bag = Some(crate::bag::output::ResultBag::create(path)?);
+    if let Some(out_bag) = &settings.out_bag {
+        outputs.bag = Some(crate::bag::output::ResultBag::create(out_bag)?);
     }
     Ok(outputs)
 }

@@ -123,6 +123,126 @@ fn imu_axes_default_to_flu() {
     );
 }
 
+/// Every bag flag is also a key of `nav --config` (paths relative to the file's
+/// folder): the file's run writes the bytes of the flags' run, and a flag given beside
+/// the file wins over its key.
+#[test]
+fn bag_flags_are_config_keys() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bag = data().join("drive.mcap");
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    let topics = [
+        "--imu-topic",
+        "/imu/data",
+        "--gnss-topic",
+        "/gnss/fix",
+        "--gnss-vel-topic",
+        "/gnss/vel",
+        "--baro-topic",
+        "/baro",
+        "--odom-topic",
+        "/odom",
+        "--end",
+        "345640",
+    ];
+    let a_bag = a.join("nav.mcap");
+    let mut flags = topics.to_vec();
+    flags.extend(["--out-bag", a_bag.to_str().expect("utf-8")]);
+    nav_bag(&bag, &a, &flags).success();
+    std::fs::create_dir_all(&b).expect("b");
+    std::fs::copy(&bag, b.join("in.mcap")).expect("copy");
+    std::fs::write(
+        b.join("nav.toml"),
+        "bag = \"in.mcap\"\nimu_topic = \"/imu/data\"\ngnss_topic = \"/gnss/fix\"\n\
+         gnss_vel_topic = \"/gnss/vel\"\nbaro_topic = \"/nowhere\"\nodom_topic = \"/odom\"\n\
+         out_bag = \"nav.mcap\"\nend = 345640\n",
+    )
+    .expect("nav.toml");
+    // The flag beside the file wins: the barometer topic of the flags' run.
+    assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--config"])
+        .arg(b.join("nav.toml"))
+        .args(["--baro-topic", "/baro"])
+        .args(common::bag::COMMON)
+        .arg("--out")
+        .arg(&b)
+        .assert()
+        .success();
+    for name in ["nav.txt", "std.txt", "imu_err.txt", "nav.mcap"] {
+        assert_eq!(
+            std::fs::read(a.join(name)).expect("a"),
+            std::fs::read(b.join(name)).expect("b"),
+            "{name}"
+        );
+    }
+    // A misspelt key is refused, naming it.
+    std::fs::write(
+        b.join("bad.toml"),
+        "bag = \"in.mcap\"\nimu_topics = \"/imu\"\n",
+    )
+    .expect("bad");
+    let e = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--config"])
+        .arg(b.join("bad.toml"))
+        .args(common::bag::COMMON)
+        .assert()
+        .failure();
+    let err = stderr_of(&e);
+    assert!(err.contains("imu_topics"), "{err}");
+}
+
+/// `--out-bag` on a full disk (the bag's path on `/dev/full`): the run fails naming
+/// the bag, and the partial file is gone (a bag without its summary is no MCAP);
+/// when another output fails instead (nav.txt on `/dev/full`), the bag written so far
+/// is a whole MCAP with its summary, read to its end.
+#[test]
+fn out_bag_on_a_full_disk_is_removed_and_named() {
+    if !Path::new("/dev/full").exists() {
+        eprintln!("no /dev/full here: the test needs it");
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).expect("out");
+    let result = out.join("result.mcap");
+    std::os::unix::fs::symlink("/dev/full", &result).expect("symlink");
+    let a = nav_bag(
+        &data().join("drive.mcap"),
+        &out,
+        &["--out-bag", result.to_str().expect("utf-8")],
+    )
+    .failure()
+    .code(1);
+    let err = stderr_of(&a);
+    assert!(
+        err.contains("result.mcap: cannot write: No space left on device"),
+        "{err}"
+    );
+    assert!(
+        !result.exists() && result.symlink_metadata().is_err(),
+        "{err}"
+    );
+
+    let out = dir.path().join("nav_full");
+    std::fs::create_dir_all(&out).expect("out");
+    std::os::unix::fs::symlink("/dev/full", out.join("nav.txt")).expect("symlink");
+    let result = dir.path().join("whole.mcap");
+    let a = nav_bag(
+        &data().join("drive.mcap"),
+        &out,
+        &["--out-bag", result.to_str().expect("utf-8")],
+    )
+    .failure();
+    let err = stderr_of(&a);
+    assert!(err.contains("nav.txt"), "{err}");
+    let bytes = std::fs::read(&result).expect("the bag stays");
+    let summary = mcap::Summary::read(&bytes).expect("a whole MCAP");
+    assert!(summary.is_some_and(|s| s.stats.is_some()), "no summary");
+    let _ = read_bag(&result);
+}
+
 /// Rows of `nav.csv` (header skipped).
 fn nav_csv(path: &Path) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(path).expect("nav.csv");
@@ -437,4 +557,277 @@ fn the_time_offset_moves_every_topic() {
     std::fs::write(dir.path().join("shifted.txt"), shifted).expect("write");
     let digits = max_digits_apart(&dir.path().join("shifted.txt"), &b.join("nav.txt"));
     assert!(digits <= 1.0, "{digits} units of the last digit apart");
+}
+
+/// `bag` copied to `out` with every header stamp and log time `shift` seconds later
+/// (the stamp's `sec` is the first field after the 4-byte CDR header in every type).
+fn shifted_bag(bag: &Path, out: &Path, shift: i32) {
+    let file = std::fs::File::create(out).expect("bag");
+    let mut w = mcap::Writer::new(std::io::BufWriter::new(file)).expect("writer");
+    let mut channels: BTreeMap<usize, u16> = BTreeMap::new();
+    let mut stream = BagStream::open(bag).expect("open");
+    while let Some(()) = stream
+        .next_with(|m| {
+            let id = *channels.entry(m.topic_index).or_insert_with(|| {
+                let t = m.topic;
+                let schema = w
+                    .add_schema(&t.type_name, &t.schema_encoding, b"")
+                    .expect("schema");
+                w.add_channel(schema, &t.name, &t.message_encoding, &BTreeMap::new())
+                    .expect("channel")
+            });
+            let mut data = m.data.to_vec();
+            let sec = i32::from_le_bytes(data[4..8].try_into().expect("4 bytes")) + shift;
+            data[4..8].copy_from_slice(&sec.to_le_bytes());
+            let log_time = m.log_time + u64::try_from(shift).expect("later") * 1_000_000_000;
+            let h = MessageHeader {
+                channel_id: id,
+                sequence: 0,
+                log_time,
+                publish_time: log_time,
+            };
+            w.write_to_known_channel(&h, &data).expect("message");
+            Ok(())
+        })
+        .expect("message")
+    {}
+    w.finish().expect("finish");
+}
+
+/// ROS stamps are UNIX time; the run's are GPS seconds of week. The bag's stamps moved
+/// to Thursday 2023-11-16, whose 00:00:00 UTC is UNIX 1 700 092 800 (2023-11-14
+/// 22:13:20 is 1 700 000 000) and 4 days + 18 leap seconds into GPS week 2288 (week
+/// 2048 began on 2019-04-07, 240 weeks before its Sunday 2023-11-12): a shift of
+/// 1 700 092 800 − 18 − 345 600 s puts every stamp at the same second of week as the
+/// committed bag's (whose stamps, before 1980, are read as they are). nav.txt must be
+/// the same bytes but for the week column, 2288; the result bag's log times move back
+/// to UNIX time, exactly the shift later; `--leap-seconds 18` (the table's count in
+/// 2023) changes nothing and 17 moves every time 1 s earlier.
+#[test]
+fn unix_stamps_become_gps_week_and_second() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let shift = 1_700_092_800 - 18 - 345_600;
+    let unix = dir.path().join("unix.mcap");
+    shifted_bag(&data().join("drive.mcap"), &unix, shift);
+    let runs = [
+        ("raw", &[][..]),
+        ("unix", &[][..]),
+        ("leap18", &["--leap-seconds", "18"][..]),
+    ];
+    for (name, extra) in runs {
+        let bag = if name == "raw" {
+            data().join("drive.mcap")
+        } else {
+            unix.clone()
+        };
+        let out = dir.path().join(name);
+        let result = dir.path().join(format!("{name}_out.mcap"));
+        let mut flags = vec![
+            "--end",
+            "345640",
+            "--out-bag",
+            result.to_str().expect("utf-8"),
+        ];
+        flags.extend(extra);
+        let a = nav_bag(&bag, &out, &flags).success();
+        if name == "unix" {
+            let err = stderr_of(&a);
+            assert!(err.contains("UNIX time: GPS week 2288"), "{err}");
+        }
+    }
+    let nav = |name: &str| {
+        std::fs::read_to_string(dir.path().join(name).join("nav.txt")).expect("nav.txt")
+    };
+    let raw = nav("raw");
+    let expected: String = raw
+        .lines()
+        .map(|l| format!("2288{}\n", l.trim_start().trim_start_matches('0')))
+        .collect();
+    assert_eq!(nav("unix"), expected);
+    assert_eq!(nav("leap18"), expected);
+    let (a, b) = (
+        read_bag(&dir.path().join("raw_out.mcap")),
+        read_bag(&dir.path().join("unix_out.mcap")),
+    );
+    for (topic, msgs) in &a {
+        let later: Vec<u64> = msgs
+            .iter()
+            .map(|m| m.0 + shift as u64 * 1_000_000_000)
+            .collect();
+        let got: Vec<u64> = b[topic].iter().map(|m| m.0).collect();
+        assert_eq!(got, later, "{topic}");
+    }
+    let out = dir.path().join("leap17");
+    nav_bag(&unix, &out, &["--end", "345639", "--leap-seconds", "17"]).success();
+    let (r, l) = (
+        common::read_rows(&dir.path().join("raw/nav.txt")),
+        common::read_rows(&out.join("nav.txt")),
+    );
+    assert_eq!(r.len(), l.len());
+    for (x, y) in r.iter().zip(&l) {
+        assert!((x[1] - 1.0 - y[1]).abs() < 1e-9, "{} / {}", x[1], y[1]);
+    }
+}
+
+/// The text reader's checks on a bag's IMU, named by topic, message and field: the
+/// plausibility check of the first messages (a specific force in g, 1/9.8 of gravity:
+/// below the 0.3 g bound), a stamp jumping by 100 s (past the 60-s interval domain),
+/// and the gap report (a missing 50 ms at 100 Hz: one interval of 0.06 s, over twice
+/// the nominal 0.01 s), printed as a warning of a run that succeeds.
+#[test]
+fn bag_imus_get_the_text_readers_checks() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let imu = [("/imu", IMU, "cdr")];
+    let in_g = dir.path().join("g.mcap");
+    write_bag(&in_g, &imu, 101, |i| {
+        let mut m = at_rest(i);
+        m.linear_acceleration[2] = 1.0;
+        m.encode()
+    });
+    let e = refused(&in_g, &[]);
+    assert!(
+        e.contains("g.mcap: topic /imu: field linear_acceleration: messages 1-101 fail the plausibility check"),
+        "{e}"
+    );
+    assert!(e.contains("--no-layout-check skips this check"), "{e}");
+    let jump = dir.path().join("jump.mcap");
+    write_bag(&jump, &imu, 101, |i| {
+        let mut m = at_rest(i);
+        if i >= 50 {
+            m.header.sec += 100;
+        }
+        m.encode()
+    });
+    let e = refused(&jump, &[]);
+    assert!(
+        e.contains("jump.mcap: topic /imu, message 51: field header.stamp: the time jumps: IMU sample interval"),
+        "{e}"
+    );
+    let gap = dir.path().join("gap.mcap");
+    write_bag(&gap, &imu, 101, |i| {
+        let i = if i >= 50 { i + 5 } else { i };
+        at_rest(i).encode()
+    });
+    let a = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--bag"])
+        .arg(&gap)
+        .args(["--init-pos", "45,7,100", "--init-att", "0,0,0", "--out"])
+        .arg(dir.path().join("gap"))
+        .assert()
+        .success();
+    let err = stderr_of(&a);
+    assert!(
+        err.contains("warning: ")
+            && err.contains("gap.mcap: topic /imu: 1 gap(s) longer than 0.02"),
+        "{err}"
+    );
+    assert!(err.contains("longest 0.06"), "{err}");
+}
+
+/// `drive.mcap` copied to `out` with every FluidPressure's variance set to `var_p`
+/// [Pa²] and every Odometry's forward-speed variance to `var_v` [m²/s²].
+fn with_variances(out: &Path, var_p: f64, var_v: f64) {
+    use schuler_cli::bag::messages::{FLUID_PRESSURE, FluidPressure, ODOMETRY};
+    let file = std::fs::File::create(out).expect("bag");
+    let mut w = mcap::Writer::new(std::io::BufWriter::new(file)).expect("writer");
+    let mut channels: BTreeMap<usize, u16> = BTreeMap::new();
+    let mut stream = BagStream::open(&data().join("drive.mcap")).expect("open");
+    while let Some(()) = stream
+        .next_with(|m| {
+            let t = m.topic;
+            let id = *channels.entry(m.topic_index).or_insert_with(|| {
+                let schema = w
+                    .add_schema(&t.type_name, &t.schema_encoding, b"")
+                    .expect("schema");
+                w.add_channel(schema, &t.name, &t.message_encoding, &BTreeMap::new())
+                    .expect("channel")
+            });
+            let data = match t.type_name.as_str() {
+                FLUID_PRESSURE => {
+                    let mut p = FluidPressure::decode(m.data).expect("pressure");
+                    p.variance = var_p;
+                    p.encode()
+                }
+                ODOMETRY => {
+                    let mut o = Odometry::decode(m.data).expect("odometry");
+                    o.twist_covariance[0] = var_v;
+                    o.encode()
+                }
+                _ => m.data.to_vec(),
+            };
+            let h = MessageHeader {
+                channel_id: id,
+                sequence: 0,
+                log_time: m.log_time,
+                publish_time: m.log_time,
+            };
+            w.write_to_known_channel(&h, &data).expect("message");
+            Ok(())
+        })
+        .expect("message")
+    {}
+    w.finish().expect("finish");
+}
+
+/// The pressure variances and the odometry's speed variance are the barometer's and
+/// the odometer's noise when no flag gives them: (4 Pa)² is 4·8.52 cm = 0.341 m of
+/// height at the drive's 245 m (hydrostatic balance `R*·T/(p·M·g₀)` at T = 286.56 K,
+/// p = 98.42 kPa; the median over the drive's heights, within 2 mm), (0.2 m/s)² is
+/// 0.2 m/s. The run with them is the run of the bag without them given those noises
+/// as flags (the same bytes), and a flag overrides the variances (the same bytes as
+/// the bag without them).
+#[test]
+fn pressure_and_odometry_variances_are_the_noise() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // The shared flags but --odometer-std (the last two).
+    let nav_bag = |bag: &Path, out: &Path, extra: &[&str]| {
+        assert_cmd::Command::cargo_bin("schuler")
+            .expect("binary")
+            .arg("nav")
+            .arg("--bag")
+            .arg(bag)
+            .args(&common::bag::COMMON[..11])
+            .args(extra)
+            .arg("--out")
+            .arg(out)
+            .assert()
+    };
+    let bag = dir.path().join("var.mcap");
+    with_variances(&bag, 16.0, 0.04);
+    let end = ["--end", "345650"];
+    let a = nav_bag(&bag, &dir.path().join("a"), &end).success();
+    let err = stderr_of(&a);
+    let printed = |what: &str, unit: &str| -> String {
+        let line = err
+            .lines()
+            .find(|l| l.contains(what))
+            .unwrap_or_else(|| panic!("{what}: {err}"));
+        let after = line.split(": ").last().expect("value");
+        after
+            .split(&format!(" {unit}"))
+            .next()
+            .expect("value")
+            .to_owned()
+    };
+    let baro = printed("barometer noise from its pressure variances", "m");
+    let odo = printed("odometer noise from its twist covariances", "m/s");
+    let baro_m: f64 = baro.parse().expect("number");
+    assert!((baro_m - 0.341).abs() < 0.002, "{baro}");
+    assert_eq!(odo, "0.2");
+    let mut flags = end.to_vec();
+    flags.extend(["--baro-std", &baro, "--odometer-std", &odo]);
+    nav_bag(&data().join("drive.mcap"), &dir.path().join("b"), &flags).success();
+    let mut flags = end.to_vec();
+    flags.extend(["--baro-std", "0.5"]);
+    let c = nav_bag(&bag, &dir.path().join("c"), &flags).success();
+    let err_c = stderr_of(&c);
+    assert!(!err_c.contains("barometer noise from"), "{err_c}");
+    let mut flags = end.to_vec();
+    flags.extend(["--odometer-std", "0.2"]);
+    nav_bag(&data().join("drive.mcap"), &dir.path().join("d"), &flags).success();
+    let read = |d: &str| std::fs::read(dir.path().join(d).join("nav.txt")).expect("nav.txt");
+    assert_eq!(read("a"), read("b"));
+    assert_eq!(read("c"), read("d"));
+    assert_ne!(read("a"), read("c"));
 }

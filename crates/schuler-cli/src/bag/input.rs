@@ -19,17 +19,21 @@
 //!   ([`isa_height`]).
 //! - `nav_msgs/Odometry`: the forward speed `twist.twist.linear.x` of the child frame.
 //!
-//! Every time is the header stamp plus [`BagReadOptions::time_offset`] (one clock for
-//! every topic of a bag).
+//! Every time is the header stamp on the run's clock ([`StampClock`]: UNIX stamps as
+//! GPS seconds of week, stamps before 1980 as they are) plus
+//! [`BagReadOptions::time_offset`] (one clock for every topic of a bag).
 
 use super::BagError;
+use super::clock::StampClock;
 use super::container::{BagStream, Message, Topic};
 use super::info::{TopicSummary, scan};
 use super::messages::{
     FLUID_PRESSURE, FluidPressure, IMU, Imu, ImuMotion, NAV_SAT_FIX, NavSatFix, ODOMETRY, Odometry,
     STATUS_NO_FIX, TWIST, TwistStamped,
 };
+use crate::formats::imu_log::{GAP_FACTOR, GapReport};
 use nalgebra::{Matrix3, Vector3};
+use schuler::domain;
 use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
 use schuler::imu::ImuSample;
@@ -107,6 +111,10 @@ pub struct BagReadOptions {
     pub default_gnss_std: Option<Vector3<f64>>,
     /// Velocity standard deviation [m/s] for velocities without a covariance.
     pub default_vel_std: f64,
+    /// GPS − UTC [s] for UNIX stamps (`None`: the leap-second table).
+    pub leap_seconds: Option<i64>,
+    /// Run the plausibility check of the IMU's first messages (as the text reader's).
+    pub check_layout: bool,
 }
 
 impl Default for BagReadOptions {
@@ -119,6 +127,8 @@ impl Default for BagReadOptions {
             t_end: None,
             default_gnss_std: None,
             default_vel_std: 0.1,
+            leap_seconds: None,
+            check_layout: true,
         }
     }
 }
@@ -141,6 +151,12 @@ pub struct BagAids {
     pub baro: Vec<(f64, f64)>,
     /// Odometer speeds `(t, v)` [s, m/s].
     pub odometer: Vec<(f64, f64)>,
+    /// The barometer's height noise [m] from the pressure variances, when messages
+    /// give them: the median over those messages of `σ_p·|dh/dp|` ([`isa_height_std`]).
+    pub baro_std: Option<f64>,
+    /// The odometer's speed noise [m/s] from the twists' covariances, when messages
+    /// give them: the median of `√C[0]` (forward speed's variance) over those messages.
+    pub odometer_std: Option<f64>,
 }
 
 /// Intervals of the IMU's first messages kept to settle its nominal interval (as the
@@ -150,7 +166,9 @@ const LOOKAHEAD: usize = 200;
 /// What the first pass found on one topic of a kind we read.
 #[derive(Debug, Default)]
 struct Gathered {
-    imu_stamps: Vec<f64>,
+    imu_stamps: Vec<(i32, u32)>,
+    /// The first messages' angular rates and specific forces (IMU axes).
+    imu_motion: Vec<([f64; 3], [f64; 3])>,
     imu_covariance: Option<([f64; 9], [f64; 9])>,
     fixes: Vec<(u64, NavSatFix)>,
     twists: Vec<(u64, TwistStamped)>,
@@ -172,6 +190,8 @@ pub struct BagPlan {
     pub chosen: [Option<String>; 5],
     /// Median interval of the IMU's first stamps [s].
     pub nominal_dt: f64,
+    /// How the stamps become the run's times.
+    pub clock: StampClock,
     /// ARW [rad/√s] and VRW [m/s/√s] per FRD axis from the IMU's covariances, if given.
     pub imu_noise: Option<(Vector3<f64>, Vector3<f64>)>,
     /// The aids.
@@ -223,7 +243,9 @@ fn gather(path: &Path, m: &Message, g: &mut Gathered) {
                     imu.linear_acceleration_covariance,
                 ));
             }
-            g.imu_stamps.push(imu.header.seconds());
+            g.imu_stamps.push((imu.header.sec, imu.header.nanosec));
+            g.imu_motion
+                .push((imu.angular_velocity, imu.linear_acceleration));
         }),
         NAV_SAT_FIX => NavSatFix::decode(m.data).map(|x| g.fixes.push((m.index, x))),
         TWIST => TwistStamped::decode(m.data).map(|x| g.twists.push((m.index, x))),
@@ -362,7 +384,7 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
         }
     };
     let imu = take(Kind::Imu)?;
-    let nominal_dt = nominal_interval(path, &imu_topic, &imu.imu_stamps)?;
+    let (clock, nominal_dt) = imu_clock(path, &imu_topic, &imu, options)?;
     let imu_noise = imu
         .imu_covariance
         .map(|(w, f)| noise_from_covariance(&w, &f, &options.c_vs, nominal_dt));
@@ -373,6 +395,10 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
         path,
         [topic(Kind::Gnss), topic(Kind::Baro)],
         [gnss?, vel?, baro?, odometry?],
+        &Times {
+            clock,
+            offset: options.time_offset,
+        },
         options,
     )?;
     Ok(BagPlan {
@@ -380,10 +406,48 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
         topics,
         chosen,
         nominal_dt,
+        clock,
         imu_noise,
         aids,
         options: options.clone(),
     })
+}
+
+/// The run's time of a header: its stamp on the clock plus the offset.
+#[derive(Debug, Clone, Copy)]
+struct Times {
+    clock: StampClock,
+    offset: f64,
+}
+
+impl Times {
+    /// The time [s] of header `h`.
+    fn of(&self, h: &super::messages::Header) -> f64 {
+        self.clock.seconds(h.sec, h.nanosec) + self.offset
+    }
+}
+
+/// The clock of the IMU topic `topic`'s first stamps (UNIX or not) and its nominal
+/// interval on it, after the plausibility check of its first messages.
+fn imu_clock(
+    path: &Path,
+    topic: &str,
+    imu: &Gathered,
+    options: &BagReadOptions,
+) -> Result<(StampClock, f64), BagError> {
+    let first_sec = imu.imu_stamps.first().map_or(0, |s| i64::from(s.0));
+    let clock = StampClock::of_first_stamp(first_sec, options.leap_seconds)
+        .map_err(|e| BagError::topic(path, topic, 1, Some("header.stamp"), e))?;
+    let stamps: Vec<f64> = imu
+        .imu_stamps
+        .iter()
+        .map(|&(sec, ns)| clock.seconds(sec, ns))
+        .collect();
+    let nominal_dt = nominal_interval(path, topic, &stamps)?;
+    if options.check_layout {
+        plausible(path, topic, &stamps, &imu.imu_motion)?;
+    }
+    Ok((clock, nominal_dt))
 }
 
 /// The aids of the chosen topics' messages (GNSS, velocity, barometer, odometry as
@@ -393,18 +457,20 @@ fn aids(
     path: &Path,
     topics: [String; 2],
     [gnss, vel, baro, odometry]: [Gathered; 4],
+    times: &Times,
     options: &BagReadOptions,
 ) -> Result<BagAids, BagError> {
     let [gnss_topic, baro_topic] = topics;
     let mut aids = BagAids::default();
-    (aids.fixes, aids.no_fix) = fixes(path, &gnss_topic, &gnss.fixes, options)?;
-    aids.unmatched_velocities = join_velocities(&mut aids.fixes, &vel.twists, options);
+    (aids.fixes, aids.no_fix) = fixes(path, &gnss_topic, &gnss.fixes, times, options)?;
+    aids.unmatched_velocities =
+        join_velocities(&mut aids.fixes, &vel.twists, times, options.default_vel_std);
     aids.baro = baro
         .pressures
         .iter()
         .map(|(i, p)| {
             isa_height(p.fluid_pressure)
-                .map(|h| (p.header.seconds() + options.time_offset, h))
+                .map(|h| (times.of(&p.header), h))
                 .ok_or_else(|| {
                     BagError::topic(
                         path,
@@ -419,11 +485,31 @@ fn aids(
     aids.odometer = odometry
         .odometry
         .iter()
-        .map(|(_, o)| (o.header.seconds() + options.time_offset, o.linear[0]))
+        .map(|(_, o)| (times.of(&o.header), o.linear[0]))
         .collect();
+    aids.baro_std = median_of(
+        baro.pressures
+            .iter()
+            .filter(|(_, p)| p.variance > 0.0)
+            .map(|(_, p)| isa_height_std(p.fluid_pressure, p.variance.sqrt())),
+    );
+    aids.odometer_std = median_of(
+        odometry
+            .odometry
+            .iter()
+            .filter(|(_, o)| o.twist_covariance[0] > 0.0)
+            .map(|(_, o)| o.twist_covariance[0].sqrt()),
+    );
     sort_by_time(&mut aids.baro);
     sort_by_time(&mut aids.odometer);
     Ok(aids)
+}
+
+/// The median of `xs` (the upper one of an even count); `None` when empty.
+fn median_of(xs: impl Iterator<Item = f64>) -> Option<f64> {
+    let mut v: Vec<f64> = xs.collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied()
 }
 
 /// Sorts `(t, x)` readings by time (bags store messages in arrival order).
@@ -445,6 +531,53 @@ fn nominal_interval(path: &Path, topic: &str, stamps: &[f64]) -> Result<f64, Bag
             "fewer than two increasing stamps: cannot settle the sample interval",
         )),
     }
+}
+
+/// The text reader's plausibility check ([`crate::formats::imu_plausibility`]) of the
+/// IMU's first messages (`stamps` [s] and their rates): rad/s, m/s² and seconds as
+/// `sensor_msgs/Imu` defines them. A failure names the messages and the field.
+fn plausible(
+    path: &Path,
+    topic: &str,
+    stamps: &[f64],
+    motion: &[([f64; 3], [f64; 3])],
+) -> Result<(), BagError> {
+    use crate::formats::ImuLayout;
+    use crate::formats::imu_columns::Plan;
+    use crate::formats::imu_log::LAYOUT_CHECK_MIN_INTERVALS;
+    use crate::formats::imu_plausibility::{Reading, Sensor, check};
+    let readings: Vec<Reading> = stamps
+        .windows(2)
+        .zip(motion.iter().skip(1))
+        .map(|(t, (w, f))| Reading {
+            dt: t[1] - t[0],
+            gyro: Vector3::from(*w),
+            accel: Vector3::from(*f),
+        })
+        .collect();
+    if readings.len() < LAYOUT_CHECK_MIN_INTERVALS {
+        return Ok(());
+    }
+    let Err(finding) = check(&readings, &Plan::kf_gins(ImuLayout::Rates), false) else {
+        return Ok(());
+    };
+    let field = match finding.sensor {
+        Sensor::Time => "header.stamp",
+        Sensor::Gyro => "angular_velocity",
+        Sensor::Accel => "linear_acceleration",
+    };
+    Err(BagError::topic(
+        path,
+        topic,
+        0,
+        Some(field),
+        format!(
+            "messages 1-{} {} (sensor_msgs/Imu holds rad/s and m/s^2 at stamps in s: the \
+             recording's publisher is at fault, and --no-layout-check skips this check)",
+            stamps.len(),
+            finding.message
+        ),
+    ))
 }
 
 /// ARW and VRW per FRD axis from one sample's rate covariances (IMU axes), turned by
@@ -469,6 +602,7 @@ fn fixes(
     path: &Path,
     topic: &str,
     msgs: &[(u64, NavSatFix)],
+    times: &Times,
     options: &BagReadOptions,
 ) -> Result<(Vec<GnssFix>, u64), BagError> {
     let mut out = Vec::with_capacity(msgs.len());
@@ -508,7 +642,7 @@ fn fixes(
             })?
         };
         out.push(GnssFix {
-            t: m.header.seconds() + options.time_offset,
+            t: times.of(&m.header),
             pos: Geodetic::from_degrees(m.latitude, m.longitude, m.altitude),
             pos_std,
             vel: None,
@@ -519,15 +653,17 @@ fn fixes(
 }
 
 /// Joins each ENU twist to the fix of the same stamp (within 1 µs) as an NED
-/// velocity; returns the twists without a fix.
+/// velocity (`default_std` [m/s] where the twist has no covariance); returns the
+/// twists without a fix.
 fn join_velocities(
     fixes: &mut [GnssFix],
     twists: &[(u64, TwistStamped)],
-    o: &BagReadOptions,
+    times: &Times,
+    default_std: f64,
 ) -> u64 {
     let mut unmatched = 0;
     for (_, tw) in twists {
-        let t = tw.header.seconds() + o.time_offset;
+        let t = times.of(&tw.header);
         let j = fixes.partition_point(|f| f.t < t - 1e-6);
         let Some(fix) = fixes.get_mut(j).filter(|f| (f.t - t).abs() <= 1e-6) else {
             unmatched += 1;
@@ -539,7 +675,7 @@ fn join_velocities(
         let std = if std.iter().all(|s| *s > 0.0) {
             std
         } else {
-            Vector3::repeat(o.default_vel_std)
+            Vector3::repeat(default_std)
         };
         fix.vel = Some((Vector3::new(n, e, -u), std));
     }
@@ -563,6 +699,14 @@ pub fn isa_height(p: f64) -> Option<f64> {
     (p > 0.0).then(|| ISA_T0 / ISA_LAPSE * (1.0 - (p / ISA_P0).powf(ISA_EXPONENT)))
 }
 
+/// The height's standard deviation [m] of a pressure `p > 0` [Pa] with standard
+/// deviation `sigma_p` [Pa], to first order: `σ_h = σ_p·|dh/dp|`,
+/// `dh/dp = −(T₀/L)·n·(p/p₀)^(n−1)/p₀` with [`ISA_EXPONENT`] `n`.
+pub fn isa_height_std(p: f64, sigma_p: f64) -> f64 {
+    let n = ISA_EXPONENT;
+    sigma_p * ISA_T0 / ISA_LAPSE * n * (p / ISA_P0).powf(n - 1.0) / ISA_P0
+}
+
 impl BagPlan {
     /// The chosen topic of `kind`.
     pub fn topic(&self, kind: Kind) -> Option<&str> {
@@ -576,9 +720,16 @@ impl BagPlan {
             path: self.path.clone(),
             topic: self.topic(Kind::Imu).unwrap_or_default().to_owned(),
             c_vs: self.options.c_vs,
-            offset: self.options.time_offset,
+            times: Times {
+                clock: self.clock,
+                offset: self.options.time_offset,
+            },
             window: (self.options.t_start, self.options.t_end),
             nominal_dt: self.nominal_dt,
+            gaps: GapReport {
+                threshold_s: GAP_FACTOR * self.nominal_dt,
+                ..GapReport::default()
+            },
             place: None,
             prev: None,
             started: false,
@@ -594,9 +745,10 @@ pub struct BagImu {
     path: PathBuf,
     topic: String,
     c_vs: Matrix3<f64>,
-    offset: f64,
+    times: Times,
     window: (Option<f64>, Option<f64>),
     nominal_dt: f64,
+    gaps: GapReport,
     /// The IMU topic's place in the stream ([`Message::topic_index`]), once seen.
     place: Option<usize>,
     prev: Option<(f64, u64)>,
@@ -610,9 +762,20 @@ impl BagImu {
         self.stream.bytes_read()
     }
 
+    /// The gaps met so far (intervals over [`GAP_FACTOR`] nominal ones, as the text
+    /// reader counts them); complete once the iteration has ended.
+    pub fn gaps(&self) -> GapReport {
+        self.gaps
+    }
+
+    /// The IMU topic's name.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
     /// The next IMU message decoded: `(index, t, ω, f)`.
     fn next_message(&mut self) -> Result<Option<(u64, f64, ImuMotion)>, BagError> {
-        let (path, topic, offset) = (&self.path, &self.topic, self.offset);
+        let (path, topic, times) = (&self.path, &self.topic, self.times);
         let place = &mut self.place;
         loop {
             let got = self.stream.next_with(|m| {
@@ -624,7 +787,9 @@ impl BagImu {
                 }
                 let imu = ImuMotion::decode(m.data)
                     .map_err(|e| BagError::decode(path, topic, m.index, e))?;
-                Ok(Some((m.index, imu.t + offset, imu)))
+                let (sec, nanosec) = imu.stamp;
+                let t = times.clock.seconds(sec, nanosec) + times.offset;
+                Ok(Some((m.index, t, imu)))
             })?;
             match got {
                 None => return Ok(None),
@@ -652,6 +817,22 @@ impl BagImu {
         self.prev = Some((t, index));
         let w = Vector3::from(imu.angular_velocity);
         let f = Vector3::from(imu.linear_acceleration);
+        // The text reader's domains: the interval, the rate, the specific force.
+        for (field, d, value) in [
+            ("header.stamp", &domain::IMU_INTERVAL, dt),
+            ("angular_velocity", &domain::ANGULAR_RATE, w.norm()),
+            ("linear_acceleration", &domain::SPECIFIC_FORCE, f.norm()),
+        ] {
+            if let Err(e) = d.check(value) {
+                let what = if field == "header.stamp" {
+                    format!("the time jumps: {e}")
+                } else {
+                    e.to_string()
+                };
+                let topic = &self.topic;
+                return Err(BagError::topic(&self.path, topic, index, Some(field), what));
+            }
+        }
         Ok(ImuSample {
             t,
             dt,
@@ -680,11 +861,14 @@ impl Iterator for BagImu {
                     return Some(Err(e));
                 }
             };
-            let sample = self.sample(index, t, &imu);
-            if sample.is_err() {
-                self.finished = true;
-                return Some(sample);
-            }
+            let had_prev = self.prev.is_some();
+            let sample = match self.sample(index, t, &imu) {
+                Ok(s) => s,
+                Err(e) => {
+                    self.finished = true;
+                    return Some(Err(e));
+                }
+            };
             if !self.started && self.window.0.is_some_and(|s| t < s) {
                 continue;
             }
@@ -693,7 +877,10 @@ impl Iterator for BagImu {
                 self.finished = true;
                 return None;
             }
-            return Some(sample);
+            if had_prev && sample.dt > self.gaps.threshold_s {
+                self.gaps.record(t, sample.dt);
+            }
+            return Some(Ok(sample));
         }
     }
 }
@@ -718,6 +905,26 @@ mod tests {
             assert!((got - h).abs() < tol, "{p} Pa: {got} m, table {h} m");
         }
         assert_eq!(isa_height(0.0), None);
+    }
+
+    /// Hydrostatic balance, independent of the ISA formula's form: `dp/dh = −ρ·g₀ =
+    /// −p·M·g₀/(R*·T)` with `T = T₀ − L·h`, so 1 Pa is `R*·T/(p·M·g₀)` of height: 8.32 cm
+    /// at sea level, 11.2 cm at 3000 m (where T = 268.65 K). The first-order σ_h must
+    /// be that to rounding (1e-12 relative).
+    #[test]
+    fn pressure_noise_becomes_height_noise_by_hydrostatic_balance() {
+        let (r, m, g0) = (8.314_32, 0.028_964_4, 9.806_65);
+        for h in [0.0, 3000.0, 10_000.0] {
+            let t = ISA_T0 - ISA_LAPSE * h;
+            let p = ISA_P0 * (t / ISA_T0).powf(1.0 / ISA_EXPONENT);
+            let expected = 2.0 * r * t / (p * m * g0);
+            let got = isa_height_std(p, 2.0);
+            assert!(
+                (got / expected - 1.0).abs() < 1e-12,
+                "{h} m: {got} / {expected}"
+            );
+        }
+        assert!((isa_height_std(ISA_P0, 1.0) - 0.083_24).abs() < 1e-5);
     }
 
     /// White noise of density N sampled every dt has σ = N/√dt: the covariance gives N

@@ -106,13 +106,13 @@ pub struct Imu {
     pub linear_acceleration_covariance: [f64; 9],
 }
 
-/// What navigation reads of a `sensor_msgs/msg/Imu`: the stamp [s], angular rate
+/// What navigation reads of a `sensor_msgs/msg/Imu`: the stamp, angular rate
 /// [rad/s] and specific force [m/s²] (frame and covariances skipped, nothing
 /// allocated).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImuMotion {
-    /// The header's stamp [s].
-    pub t: f64,
+    /// The header's stamp: `sec`, `nanosec` (below 10⁹).
+    pub stamp: (i32, u32),
     /// Angular rate, IMU axes.
     pub angular_velocity: [f64; 3],
     /// Specific force, IMU axes.
@@ -132,7 +132,7 @@ impl ImuMotion {
         let linear_acceleration = vector3(&mut r, "linear_acceleration")?;
         r.skip_f64s(9, "linear_acceleration_covariance")?;
         Ok(Self {
-            t: stamp_seconds(sec, nanosec),
+            stamp: (sec, nanosec),
             angular_velocity,
             linear_acceleration,
         })
@@ -289,6 +289,15 @@ impl FluidPressure {
             fluid_pressure,
             variance,
         })
+    }
+
+    /// Encodes the message (for test bags).
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        self.header.write(&mut w);
+        w.f64(self.fluid_pressure);
+        w.f64(self.variance);
+        w.finish()
     }
 }
 
@@ -491,7 +500,7 @@ mod tests {
             linear_acceleration_covariance: [1e-4; 9],
         };
         let motion = ImuMotion::decode(&imu.encode()).expect("motion");
-        assert_eq!(motion.t, imu.header.seconds());
+        assert_eq!(motion.stamp, (imu.header.sec, imu.header.nanosec));
         assert_eq!(motion.angular_velocity, imu.angular_velocity);
         assert_eq!(motion.linear_acceleration, imu.linear_acceleration);
         assert_eq!(Imu::decode(&imu.encode()), Ok(imu));

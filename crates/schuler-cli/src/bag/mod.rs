@@ -1,11 +1,12 @@
 //! ROS 2 bags (MCAP) in and out, kept apart from the command line so that another
 //! front end (the Python package) can use them as they are: [`container`] reads the
-//! MCAP records front to back, [`cdr`] and [`messages`] decode and encode the few
+//! MCAP records front to back, [`clock`] turns UNIX stamps into GPS time, [`cdr`] and [`messages`] decode and encode the few
 //! message types, [`info`] summarises a bag, [`input`] turns its topics into the
 //! session's samples and aids (FLU/ENU to FRD/NED at this edge, REP 103/105), and
 //! [`output`] writes a trajectory Foxglove can show.
 
 pub mod cdr;
+pub mod clock;
 pub mod container;
 pub mod info;
 pub mod input;

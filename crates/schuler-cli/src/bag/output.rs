@@ -9,10 +9,13 @@
 //! - with a filter, `/schuler/gyro_bias` [rad/s] and `/schuler/accel_bias` [m/s²]
 //!   (`geometry_msgs/Vector3Stamped`) in `base_link` axes.
 //!
-//! Stamps are the epoch times (`sec` = ⌊t⌋, `nanosec` the rest rounded to 1 ns); the
-//! MCAP log time is the same instant in ns.
+//! Stamps are the epoch times (`sec` = ⌊t⌋, `nanosec` the rest rounded to 1 ns) on
+//! the input bag's clock: GPS seconds of week back to UNIX time when its stamps were
+//! UNIX time ([`StampClock`]), as they are otherwise; the MCAP log time is the same
+//! instant in ns.
 
 use super::BagError;
+use super::clock::StampClock;
 use super::messages::{
     Header, NAV_SAT_FIX, NavSatFix, ODOMETRY, Odometry, VECTOR3_STAMPED, Vector3Stamped,
     definitions,
@@ -45,7 +48,13 @@ fn ecef_to_enu(lat: f64, lon: f64) -> Matrix3<f64> {
 /// rounds to 10⁹ carries into `sec`), and the same instant in ns; `None` for a time
 /// outside the stamp's range (negative, or past 2038 as `int32` seconds).
 pub fn stamp(t: f64) -> Option<(i32, u32, u64)> {
-    if !(t >= 0.0 && t < f64::from(i32::MAX)) {
+    stamp_on(&StampClock::Raw, t)
+}
+
+/// [`stamp`] of the run's time `t` [s] on `clock` (GPS seconds of week back to UNIX
+/// time).
+pub fn stamp_on(clock: &StampClock, t: f64) -> Option<(i32, u32, u64)> {
+    if !(t.is_finite() && t.abs() < 1e15) {
         return None;
     }
     let mut sec = t.floor();
@@ -54,8 +63,20 @@ pub fn stamp(t: f64) -> Option<(i32, u32, u64)> {
         sec += 1.0;
         ns -= 1e9;
     }
-    let (sec, ns) = (sec as i32, ns as u32);
+    let sec = i32::try_from(clock.unix_second(sec as i64))
+        .ok()
+        .filter(|s| *s >= 0)?;
+    let ns = ns as u32;
     Some((sec, ns, sec as u64 * 1_000_000_000 + u64::from(ns)))
+}
+
+/// Where a run's result bag goes, and the clock of its stamps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutBag {
+    /// The `.mcap` file.
+    pub path: PathBuf,
+    /// The input bag's clock ([`StampClock::Raw`] for any other input).
+    pub clock: StampClock,
 }
 
 /// The topics written, their types and definitions.
@@ -70,6 +91,7 @@ const TOPICS: [(&str, &str); 4] = [
 pub struct ResultBag {
     writer: mcap::Writer<BufWriter<File>>,
     path: PathBuf,
+    clock: StampClock,
     channels: [u16; 4],
     sequence: u32,
     /// ECEF position of the ENU origin and ECEF→ENU there.
@@ -77,9 +99,10 @@ pub struct ResultBag {
 }
 
 impl ResultBag {
-    /// Creates `path` with the four channels.
-    pub fn create(path: &Path) -> Result<Self, BagError> {
-        let err = |e: mcap::McapError| BagError::file(path, e.to_string());
+    /// Creates the bag with the four channels.
+    pub fn create(out: &OutBag) -> Result<Self, BagError> {
+        let path = out.path.as_path();
+        let err = |e: mcap::McapError| failed(path, e);
         let file =
             File::create(path).map_err(|e| BagError::file(path, format!("cannot create: {e}")))?;
         let mut writer = mcap::WriteOptions::new()
@@ -104,6 +127,7 @@ impl ResultBag {
         Ok(Self {
             writer,
             path: path.to_path_buf(),
+            clock: out.clock,
             channels,
             sequence: 0,
             origin: None,
@@ -120,13 +144,13 @@ impl ResultBag {
         };
         self.writer
             .write_to_known_channel(&header, data)
-            .map_err(|e| BagError::file(&self.path, e.to_string()))
+            .map_err(|e| failed(&self.path, e))
     }
 
     /// Writes the messages of epoch `e`.
     pub fn write_epoch(&mut self, e: &Epoch) -> Result<(), BagError> {
         let t = e.state.t;
-        let (sec, nanosec, log_time) = stamp(t).ok_or_else(|| {
+        let (sec, nanosec, log_time) = stamp_on(&self.clock, t).ok_or_else(|| {
             BagError::file(
                 &self.path,
                 format!("epoch t = {t} s has no ROS stamp (negative or past 2038)"),
@@ -196,11 +220,32 @@ impl ResultBag {
 
     /// Writes the summary and closes the file.
     pub fn finish(mut self) -> Result<(), BagError> {
-        self.writer
-            .finish()
-            .map_err(|e| BagError::file(&self.path, e.to_string()))?;
+        self.writer.finish().map_err(|e| failed(&self.path, e))?;
         Ok(())
     }
+}
+
+/// The error of a failed write to the bag at `path` (the disk full), naming it; the
+/// partial file is removed, since a bag cut short of its summary is no MCAP a reader
+/// opens whole. (A bag dropped on another output's failure is finished by the `mcap`
+/// writer's drop: it stays a valid MCAP of the epochs written.)
+fn failed(path: &Path, e: mcap::McapError) -> BagError {
+    let reason = match e {
+        mcap::McapError::Io(io) => io.to_string(),
+        other => other.to_string(),
+    };
+    let removed = std::fs::remove_file(path).is_ok();
+    BagError::file(
+        path,
+        format!(
+            "cannot write: {reason}{}",
+            if removed {
+                " (the partial bag was removed)"
+            } else {
+                ""
+            }
+        ),
+    )
 }
 
 /// A longitude [deg] in [−180, 180]; one already there unchanged (bit for bit).

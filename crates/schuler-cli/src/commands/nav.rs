@@ -16,6 +16,7 @@
 
 use crate::aided::{Aiding, AidingOptions, GivenReadings};
 use crate::alignment::AlignOptions;
+use crate::bag_input::BagArgs;
 use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
@@ -120,7 +121,7 @@ pub struct NavArgs {
     pub aiding: AidingOptions,
     /// ROS 2 bags: `--bag` as the input, `--out-bag` for the result.
     #[command(flatten)]
-    pub bag: crate::bag_input::BagArgs,
+    pub bag: BagArgs,
 }
 
 /// The same options as a TOML file.
@@ -145,6 +146,14 @@ struct NavConfig {
     init: Option<InitChoice>,
     alignment: Option<AlignOptions>,
     aiding: Option<AidingOptions>,
+    bag: Option<PathBuf>,
+    imu_topic: Option<String>,
+    gnss_topic: Option<String>,
+    gnss_vel_topic: Option<String>,
+    baro_topic: Option<String>,
+    odom_topic: Option<String>,
+    out_bag: Option<PathBuf>,
+    leap_seconds: Option<i64>,
     /// The IMU input keys, read apart ([`ImuInputOptions::split_config`]).
     #[serde(skip)]
     input: ImuInputOptions,
@@ -171,12 +180,29 @@ fn load_config(path: &Path) -> Result<NavConfig> {
         ImuInputOptions::split_config(&text).with_context(|| format!("in {}", path.display()))?;
     cfg.input = input;
     let base = path.parent().unwrap_or(Path::new(""));
-    for p in [&mut cfg.imu, &mut cfg.out].into_iter().flatten() {
+    let paths = [&mut cfg.imu, &mut cfg.out, &mut cfg.bag, &mut cfg.out_bag];
+    for p in paths.into_iter().flatten() {
         if p.is_relative() {
             *p = base.join(&*p);
         }
     }
     Ok(cfg)
+}
+
+impl NavConfig {
+    /// The bag keys (paths already relative to the file's folder).
+    fn bag_args(&self) -> BagArgs {
+        BagArgs {
+            bag: self.bag.clone(),
+            imu_topic: self.imu_topic.clone(),
+            gnss_topic: self.gnss_topic.clone(),
+            gnss_vel_topic: self.gnss_vel_topic.clone(),
+            baro_topic: self.baro_topic.clone(),
+            odom_topic: self.odom_topic.clone(),
+            out_bag: self.out_bag.clone(),
+            leap_seconds: self.leap_seconds,
+        }
+    }
 }
 
 /// The mechanization options of flags over config, checked.
@@ -223,6 +249,8 @@ pub struct NavPlan {
     /// Whether the IMU's axes were given (`--imu-axes`, `--imu-rotation`): a bag's
     /// IMU is FLU otherwise.
     pub axes_given: bool,
+    /// The bag flags over the configuration's bag keys.
+    pub bag: BagArgs,
 }
 
 /// The initial position of flags over config, checked.
@@ -289,15 +317,19 @@ fn plan(args: NavArgs) -> Result<NavPlan> {
     }
     let input = args.input.clone().or(cfg.input.clone());
     let axes_given = input.imu_axes.is_some() || input.imu_rotation.is_some();
-    if args.bag.bag.is_some() {
+    let bag = args.bag.clone().or(cfg.bag_args());
+    if bag.bag.is_some() {
         check_bag_input(&input)?;
+        if args.imu.is_some() || cfg.imu.is_some() {
+            bail!("an IMU log and a bag are both given (--imu or `imu`, --bag or `bag`): give one");
+        }
     }
     let settings = NavSettings {
         imu: args
             .imu
             .clone()
             .or(cfg.imu.clone())
-            .or(args.bag.bag.clone())
+            .or(bag.bag.clone())
             .context(
                 "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config) or --bag BAG",
             )?,
@@ -323,7 +355,10 @@ fn plan(args: NavArgs) -> Result<NavPlan> {
             .map_err(anyhow::Error::msg)?,
         week: args.week.or(cfg.week).unwrap_or(0),
         mechanization: mechanization_config(&args, &cfg)?,
-        out_bag: args.bag.out_bag.clone(),
+        out_bag: bag.out_bag.clone().map(|path| crate::bag::output::OutBag {
+            path,
+            clock: Default::default(),
+        }),
     };
     let alignment = args
         .alignment
@@ -344,6 +379,7 @@ fn plan(args: NavArgs) -> Result<NavPlan> {
         alignment,
         aiding,
         axes_given,
+        bag,
     })
 }
 
@@ -638,10 +674,9 @@ pub(crate) fn print_summary(
 /// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
 /// [`crate::commands::run_nav`]; `--bag` goes to [`crate::bag_input::run`]).
 pub fn run(args: NavArgs) -> Result<()> {
-    let bag = args.bag.clone();
     let plan = parse_nav_args(args)?;
-    if bag.bag.is_some() {
-        return crate::bag_input::run(plan, &bag);
+    if plan.bag.bag.is_some() {
+        return crate::bag_input::run(plan);
     }
     let mut aiding: Option<Aiding> = plan.aiding.resolve(filter_grade(&plan).noise()?)?;
     let settings = &plan.settings;

@@ -237,7 +237,8 @@ impl GapReport {
         self.count == 0
     }
 
-    fn record(&mut self, t: f64, dt: f64) {
+    /// Counts a gap of `dt` [s] ending at the sample at `t`.
+    pub fn record(&mut self, t: f64, dt: f64) {
         self.count += 1;
         if self.first_at_t.is_none() {
             self.first_at_t = Some(t);
