@@ -350,6 +350,29 @@ pub fn to_json(a: &Alignment) -> serde_json::Value {
     })
 }
 
+/// Columns of `align_convergence.csv` ([`convergence_row`]).
+pub const CONVERGENCE_COLUMNS: [&str; 10] = [
+    "t",
+    "roll_std_deg",
+    "pitch_std_deg",
+    "yaw_std_deg",
+    "gyro_bias_std_x_dph",
+    "gyro_bias_std_y_dph",
+    "gyro_bias_std_z_dph",
+    "accel_bias_std_x_mgal",
+    "accel_bias_std_y_mgal",
+    "accel_bias_std_z_mgal",
+];
+
+/// One row of `align_convergence.csv`: time [s], the attitude standard deviations
+/// [deg], the gyro bias ones [deg/h] and the accelerometer bias ones [mGal].
+pub fn convergence_row(c: &schuler::align::fine::Convergence) -> [f64; 10] {
+    let a = c.attitude_std.map(f64::to_degrees);
+    let g = c.gyro_bias_std / DEG_PER_H;
+    let b = c.accel_bias_std / MGAL;
+    [c.t, a.x, a.y, a.z, g.x, g.y, g.z, b.x, b.y, b.z]
+}
+
 /// Write `align.json`, `align_convergence.csv` and `align_convergence.svg` into `dir`.
 pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -357,18 +380,10 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
     let path = dir.join("align.json");
     crate::line_file::write_whole(&path, json + "\n")?;
     let Some(fine) = &a.fine else { return Ok(()) };
-    let mut csv = String::from(
-        "t,roll_std_deg,pitch_std_deg,yaw_std_deg,gyro_bias_std_x_dph,gyro_bias_std_y_dph,gyro_bias_std_z_dph,accel_bias_std_x_mgal,accel_bias_std_y_mgal,accel_bias_std_z_mgal\n",
-    );
+    let mut csv = CONVERGENCE_COLUMNS.join(",") + "\n";
     for c in &fine.convergence {
-        let a = c.attitude_std.map(f64::to_degrees);
-        let g = c.gyro_bias_std / DEG_PER_H;
-        let b = c.accel_bias_std / MGAL;
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{},{},{},{}",
-            c.t, a.x, a.y, a.z, g.x, g.y, g.z, b.x, b.y, b.z
-        );
+        let row = convergence_row(c).map(|x| x.to_string());
+        let _ = writeln!(csv, "{}", row.join(","));
     }
     let path = dir.join("align_convergence.csv");
     crate::line_file::write_whole(&path, csv)?;

@@ -17,8 +17,8 @@ use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
 use schuler::session::{
-    Aid, Finished, HeadingBank, MechanizationConfig, Session, SessionConfig, SessionError, Start,
-    Summary,
+    Aid, Chosen, Finished, HeadingBank, MechanizationConfig, Session, SessionConfig, SessionError,
+    Start, Summary,
 };
 use std::path::{Path, PathBuf};
 
@@ -333,6 +333,38 @@ where
     I: Iterator<Item = Result<ImuSample, Fail>>,
     Fail: std::error::Error + Send + Sync + 'static,
 {
+    let (chosen, decided) = decide_heading(
+        earth,
+        settings,
+        aiding,
+        start,
+        (members, decide_after),
+        &mut samples,
+    )?;
+    let mut out = outputs(&earth, settings, Some(aiding))?;
+    for e in chosen.events {
+        out.event(e)?;
+    }
+    let driven = drive(chosen.session, samples, out, &settings.out, on_sample)?;
+    let summary = conclude(&earth, settings, Some(aiding), driven)?;
+    Ok((summary, chosen.yaw0, decided))
+}
+
+/// The heading bank of [`navigate_any_heading`] run on `samples` (as many as it
+/// needs) with `members` sessions until it decides or `decide_after` seconds past
+/// the first sample: the member kept, and the time of the last sample pushed [s].
+pub fn decide_heading<E: EarthModel, I, Fail>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: &Aiding,
+    start: Start,
+    (members, decide_after): (usize, f64),
+    samples: &mut I,
+) -> Result<(Chosen<E>, f64)>
+where
+    I: Iterator<Item = Result<ImuSample, Fail>>,
+    Fail: std::error::Error + Send + Sync + 'static,
+{
     let config = settings.session_config(Some(aiding));
     let mut bank = HeadingBank::new(earth, config, start, members)
         .map_err(named_flag)?
@@ -356,14 +388,7 @@ where
             }
         }
     }
-    let chosen = bank.decide();
-    let mut out = outputs(&earth, settings, Some(aiding))?;
-    for e in chosen.events {
-        out.event(e)?;
-    }
-    let driven = drive(chosen.session, samples, out, &settings.out, on_sample)?;
-    let summary = conclude(&earth, settings, Some(aiding), driven)?;
-    Ok((summary, chosen.yaw0, decided))
+    Ok((bank.decide(), decided))
 }
 
 /// Log-likelihood lead [nats] at which the heading bank decides: a likelihood ratio of

@@ -8,17 +8,23 @@ use pyo3::types::PyDict;
 /// Numeric columns with fixed names (units in the names).
 #[derive(Debug, Clone)]
 pub struct Columns {
-    names: &'static [&'static str],
+    names: Vec<&'static str>,
     data: Vec<Vec<f64>>,
 }
 
 impl Columns {
     /// Empty columns named `names`.
-    pub fn new(names: &'static [&'static str]) -> Self {
+    pub fn new(names: &[&'static str]) -> Self {
         Self {
-            names,
+            names: names.to_vec(),
             data: vec![Vec::new(); names.len()],
         }
+    }
+
+    /// Empty columns named by the lists `parts` one after the other (a table that
+    /// extends another's columns, e.g. the simulated fixes' `outlier` after [`GNSS`]).
+    pub fn joined(parts: &[&[&'static str]]) -> Self {
+        Self::new(&parts.concat())
     }
 
     /// Appends one row: `first` then `rest`, as many values as there are columns.
@@ -140,4 +146,19 @@ pub const GNSS: &[&str] = &[
     "std_vn_mps",
     "std_ve_mps",
     "std_vd_mps",
+];
+
+/// Columns of an alignment's convergence, as `align_convergence.csv`
+/// ([`schuler_cli::alignment::convergence_row`]).
+pub const CONVERGENCE: &[&str] = &[
+    "t_s",
+    "roll_std_deg",
+    "pitch_std_deg",
+    "yaw_std_deg",
+    "gyro_bias_std_x_degph",
+    "gyro_bias_std_y_degph",
+    "gyro_bias_std_z_degph",
+    "accel_bias_std_x_mgal",
+    "accel_bias_std_y_mgal",
+    "accel_bias_std_z_mgal",
 ];

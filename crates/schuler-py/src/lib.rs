@@ -3,8 +3,10 @@
 //! Python side (`python/schuler/`) turns keyword arguments into the CLI's flags and
 //! the dicts of numpy arrays returned here into pandas DataFrames.
 
+mod align;
 mod allan;
 mod arrays;
+mod channel;
 mod columns;
 mod compare;
 mod errors;
@@ -20,7 +22,7 @@ use errors::IntoPy;
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use run::{AnySession, Plan, Tables};
+use run::{Plan, Tables};
 use schuler_cli::aided::GivenReadings;
 
 /// Views of IMU columns `t, dtheta_x..z, dvel_x..z` and an optional `dt`.
@@ -63,8 +65,9 @@ pub(crate) fn given_readings(
 
 /// Navigates as `schuler nav` with `flags`: the IMU samples from `imu` (columns) or the
 /// file of `--imu`, aids from `gnss`/`baro` columns or their files. Returns the tables
-/// (see [`Tables::take_dict`]), `smoothed` (with `--smooth`) and `summary`. The GIL is
-/// released while it runs.
+/// (see [`Tables::take_dict`]), `smoothed` (with `--smooth`), `summary` and how the
+/// run started (`alignment` with `--align`, `start_in_motion` with `--init gnss`).
+/// The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (flags, imu=None, imu_dt=None, gnss=None, baro=None))]
 fn navigate<'py>(
@@ -75,7 +78,7 @@ fn navigate<'py>(
     gnss: Option<Vec<PyReadonlyArray1<'py, f64>>>,
     baro: Option<(PyReadonlyArray1<'py, f64>, PyReadonlyArray1<'py, f64>)>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let plan = given_readings(gnss, baro)
+    let mut plan = given_readings(gnss, baro)
         .and_then(|given| Plan::new(&flags, given))
         .py_err(py)?;
     let views = match &imu {
@@ -83,28 +86,21 @@ fn navigate<'py>(
         None => None,
     };
     let mut tables = Tables::default();
-    let (finished, smoothed) = py
+    let (finished, smoothed, began) = py
         .detach(|| -> anyhow::Result<_> {
-            let mut session = AnySession::open(&plan)?;
-            let (s, t) = (&plan.settings, &mut tables);
-            let n = match &views {
-                Some(v) => run::drive(&mut session, t, v.samples(s.read.t_start, s.read.t_end)?)?,
+            let (path, read) = (plan.settings.imu.clone(), plan.settings.read.clone());
+            match &views {
+                Some(v) => run::run(&mut plan, &mut tables, v.samples(read.t_start, read.t_end)?),
                 None => {
-                    let reader = schuler_cli::formats::ImuReader::open(&s.imu, &s.read)?;
-                    run::drive(&mut session, t, reader)?
+                    let reader = schuler_cli::formats::ImuReader::open(&path, &read)?;
+                    run::run(&mut plan, &mut tables, reader)
                 }
-            };
-            if n == 0 {
-                anyhow::bail!(
-                    "{}: no IMU sample in the requested time window",
-                    s.imu.display()
-                );
             }
-            session.finish(t)
         })
         .py_err(py)?;
     let d = tables.take_dict(py)?;
     session::add_finished(py, &d, &finished, smoothed.as_deref())?;
+    align::add_began(py, &d, &began)?;
     Ok(d)
 }
 
@@ -119,9 +115,15 @@ fn _schuler(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     m.add_function(wrap_pyfunction!(allan::allan, m)?)?;
+    m.add_function(wrap_pyfunction!(allan::allan_fit, m)?)?;
+    m.add_function(wrap_pyfunction!(align::align, m)?)?;
+    m.add_function(wrap_pyfunction!(channel::channel, m)?)?;
+    m.add_function(wrap_pyfunction!(channel::closed_form, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo::montecarlo_seeds, m)?)?;
     m.add_class::<session::PySession>()?;
     m.add("SchulerError", m.py().get_type::<errors::SchulerError>())?;
     m.add("InputError", m.py().get_type::<errors::InputError>())?;
+    m.add("CAMPAIGN_COLUMNS", schuler_cli::campaign::COLUMNS.to_vec())?;
+    m.add("NAV_COLUMNS", columns::NAV.to_vec())?;
     Ok(())
 }

@@ -6,18 +6,27 @@
 //! `rejected.csv` print.
 
 use crate::columns::{Columns, INNOVATIONS, NAV, SENSOR, STD};
-use anyhow::{Result, bail};
+use anyhow::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use schuler::align::Alignment;
+use schuler::align::in_motion::InMotionStart;
+use schuler::earth::EarthModel;
 use schuler::earth::{Sphere, Wgs84, Wgs84Series};
 use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
+use schuler::session::Start;
 use schuler::session::{Epoch, Event, Finished, Session};
 use schuler_cli::aided::record::InnovationRow;
 use schuler_cli::aided::{Aiding, GivenReadings};
-use schuler_cli::commands::nav::{InitChoice, parse_nav_args, resolve_aiding};
+use schuler_cli::alignment::AlignOptions;
+use schuler_cli::commands::nav::{
+    BANK_MEMBERS, BANK_SECONDS, InitChoice, align_start, motion_start, parse_nav_args,
+    resolve_aiding,
+};
 use schuler_cli::drive::{Refusal, imu_err_row, std_row};
-use schuler_cli::navigate::{NavSettings, open_session};
+use schuler_cli::formats::InputError;
+use schuler_cli::navigate::{NavSettings, decide_heading, open_session};
 use schuler_cli::options::EarthChoice;
 use schuler_cli::output::nav_fields;
 
@@ -27,22 +36,54 @@ pub struct Plan {
     pub settings: NavSettings,
     /// The filter and the aids, if any aiding is given.
     pub aiding: Option<Aiding>,
+    /// The alignment options with `--align`.
+    pub align: Option<AlignOptions>,
+    /// How the run starts (`--init`).
+    pub init: InitChoice,
+}
+
+/// How a run began: from the given state, after an alignment at rest, or in motion
+/// from the GNSS fixes.
+pub enum Began {
+    /// From `--init-pos`, `--init-vel`, `--init-att`.
+    Given,
+    /// After `--align`.
+    Aligned(Box<Alignment>),
+    /// With `--init gnss` or `gnss-any-heading`.
+    InMotion(InMotionStart),
 }
 
 impl Plan {
     /// The plan of `flags` with `given` readings in place of `--gnss`/`--baro` files.
     pub fn new(flags: &[String], given: GivenReadings) -> Result<Self> {
         let plan = parse_nav_args(crate::options::nav_args(flags)?)?;
-        if plan.align || plan.init != InitChoice::Given {
-            bail!(
-                "align and init=\"gnss\" are not available from Python yet: give init_att \
-                 (and init_vel), or run `schuler nav --align` / `--init gnss`"
-            );
-        }
         let aiding = resolve_aiding(&plan.alignment, &plan.aiding, given)?;
         Ok(Self {
             settings: plan.settings,
             aiding,
+            align: plan.align.then_some(plan.alignment),
+            init: plan.init,
+        })
+    }
+
+    /// The start as `schuler nav` makes it (given, aligned at rest on the first
+    /// samples, or in motion from the fixes), the samples it read past the start
+    /// (its carrier first), and how it began; the filter's prior follows the start.
+    pub fn begin<I>(&mut self, samples: &mut I) -> Result<(Start, Vec<ImuSample>, Began)>
+    where
+        I: Iterator<Item = Result<ImuSample, InputError>>,
+    {
+        let (s, aiding) = (&self.settings, self.aiding.as_mut());
+        Ok(match (&self.align, self.init) {
+            (Some(opts), _) => {
+                let (start, head, a) = align_start(s, opts, samples, aiding)?;
+                (start, head, Began::Aligned(Box::new(a)))
+            }
+            (None, InitChoice::Given) => (s.start(), Vec::new(), Began::Given),
+            (None, init) => {
+                let (start, head, m) = motion_start(s, samples, aiding, init)?;
+                (start, head, Began::InMotion(m))
+            }
         })
     }
 }
@@ -69,19 +110,20 @@ macro_rules! each {
 }
 
 impl AnySession {
-    /// The session of `plan`, aids pushed, starting at the first sample.
-    pub fn open(plan: &Plan) -> Result<Self> {
-        let (s, a) = (&plan.settings, plan.aiding.as_ref());
-        Ok(match s.earth {
-            EarthChoice::Wgs84 => Self::Wgs84(open_session(Wgs84, s, a, s.start())?),
-            EarthChoice::Wgs84Series => {
-                Self::Wgs84Series(open_session(Wgs84Series, s, a, s.start())?)
-            }
-            EarthChoice::Sphere => {
-                Self::Sphere(open_session(Sphere::textbook(true), s, a, s.start())?)
-            }
+    /// The session of `plan` from `start`, aids pushed; with `--init
+    /// gnss-any-heading` the heading bank's choice after it ran on as many of
+    /// `samples` as it needed (its events so far go into `tables`).
+    pub fn open<I>(plan: &Plan, start: Start, samples: &mut I, tables: &mut Tables) -> Result<Self>
+    where
+        I: Iterator<Item = Result<ImuSample, InputError>>,
+    {
+        let (p, s, t) = (plan, start, samples);
+        Ok(match plan.settings.earth {
+            EarthChoice::Wgs84 => Self::Wgs84(open_on(Wgs84, p, s, t, tables)?),
+            EarthChoice::Wgs84Series => Self::Wgs84Series(open_on(Wgs84Series, p, s, t, tables)?),
+            EarthChoice::Sphere => Self::Sphere(open_on(Sphere::textbook(true), p, s, t, tables)?),
             EarthChoice::SphereFixed => {
-                Self::Sphere(open_session(Sphere::textbook(false), s, a, s.start())?)
+                Self::Sphere(open_on(Sphere::textbook(false), p, s, t, tables)?)
             }
         })
     }
@@ -119,6 +161,31 @@ impl AnySession {
             let smoothed = finished.smoothed.take().map(|s| s.collect_states(earth));
             Ok((finished, smoothed.transpose()?))
         })
+    }
+}
+
+/// The session of [`AnySession::open`] on `earth`.
+fn open_on<E: EarthModel, I>(
+    earth: E,
+    plan: &Plan,
+    start: Start,
+    samples: &mut I,
+    tables: &mut Tables,
+) -> Result<Session<E>>
+where
+    I: Iterator<Item = Result<ImuSample, InputError>>,
+{
+    let (s, a) = (&plan.settings, plan.aiding.as_ref());
+    match a.filter(|_| plan.init == InitChoice::GnssAnyHeading) {
+        Some(a) => {
+            let bank = (BANK_MEMBERS, BANK_SECONDS);
+            let (chosen, _) = decide_heading(earth, s, a, start, bank, samples)?;
+            for e in chosen.events {
+                tables.event(e);
+            }
+            Ok(chosen.session)
+        }
+        None => open_session(earth, s, a, start),
     }
 }
 
@@ -229,12 +296,39 @@ impl Tables {
     }
 }
 
+/// Runs `plan` on `samples` as `schuler nav` does: the start (given, aligned, in
+/// motion, or through the heading bank), then every sample pushed, what comes out
+/// collected into `tables`; the finished session, its smoothed trajectory (when
+/// asked) and how it began.
+pub fn run<I>(
+    plan: &mut Plan,
+    tables: &mut Tables,
+    samples: I,
+) -> Result<(Finished, Option<Vec<Smoothed>>, Began)>
+where
+    I: Iterator<Item = Result<ImuSample, InputError>>,
+{
+    let mut samples = samples.peekable();
+    if samples.peek().is_none() {
+        anyhow::bail!(
+            "{}: no IMU sample in the requested time window",
+            plan.settings.imu.display()
+        );
+    }
+    let (start, head, began) = plan.begin(&mut samples)?;
+    let mut all = head.into_iter().map(Ok).chain(samples);
+    let mut session = AnySession::open(plan, start, &mut all, tables)?;
+    drive(&mut session, tables, all)?;
+    let (finished, smoothed) = session.finish(tables)?;
+    Ok((finished, smoothed, began))
+}
+
 /// Pushes `samples` into `session`, collecting what comes out into `tables` after
 /// each; returns the count pushed. A read error or a refused sample stops the run.
 pub fn drive(
     session: &mut AnySession,
     tables: &mut Tables,
-    samples: impl Iterator<Item = Result<ImuSample, schuler_cli::formats::InputError>>,
+    samples: impl Iterator<Item = Result<ImuSample, InputError>>,
 ) -> Result<u64> {
     let mut n = 0;
     for s in samples {
@@ -248,7 +342,8 @@ pub fn drive(
 /// The smoothed trajectory: `nav.txt`'s columns, then the position, velocity and
 /// attitude standard deviations of `std.txt`.
 pub fn smoothed_columns(smoothed: &[Smoothed]) -> Columns {
-    let mut c = Columns::new(SMOOTHED);
+    // nav.txt's columns, then std.txt's of position, velocity and attitude.
+    let mut c = Columns::joined(&[NAV, &STD[1..10]]);
     for s in smoothed {
         let mut row = nav_fields(&s.state).to_vec();
         row.extend(s.std[0].iter().chain(s.std[1].iter()));
@@ -257,29 +352,6 @@ pub fn smoothed_columns(smoothed: &[Smoothed]) -> Columns {
     }
     c
 }
-
-/// Columns of the smoothed trajectory.
-const SMOOTHED: &[&str] = &[
-    "t_s",
-    "lat_deg",
-    "lon_deg",
-    "h_m",
-    "vn_mps",
-    "ve_mps",
-    "vd_mps",
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
-    "std_n_m",
-    "std_e_m",
-    "std_d_m",
-    "std_vn_mps",
-    "std_ve_mps",
-    "std_vd_mps",
-    "std_roll_deg",
-    "std_pitch_deg",
-    "std_yaw_deg",
-];
 
 /// The session's summary as a dict: samples, time span, measurement counts, mean NIS
 /// per degree of freedom, hand-overs.

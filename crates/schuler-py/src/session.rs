@@ -2,6 +2,7 @@
 //! Python, configured by the same flags as `navigate`.
 
 use crate::errors::IntoPy;
+use crate::errors::SchulerError;
 use crate::run::{AnySession, Plan, Tables, smoothed_columns, summary_dict};
 use nalgebra::Vector3;
 use numpy::PyReadonlyArray1;
@@ -13,6 +14,7 @@ use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::{Aid, Finished};
 use schuler_cli::aided::GivenReadings;
+use schuler_cli::commands::nav::InitChoice;
 
 /// A navigation session fed by pushes; its tables are taken as they grow.
 #[pyclass(name = "Session", module = "schuler._schuler")]
@@ -60,9 +62,17 @@ impl PySession {
             baro: baro.then(Vec::new),
         };
         let plan = Plan::new(&flags, given).py_err(py)?;
-        let session = AnySession::open(&plan).py_err(py)?;
+        if plan.align.is_some() || plan.init != InitChoice::Given {
+            return Err(SchulerError::new_err(
+                "a Session starts from the given state (init_pos, init_vel, init_att): \
+                 align=True and init=\"gnss\" read the first samples, use navigate() for them",
+            ));
+        }
+        let mut tables = Tables::default();
+        let start = plan.settings.start();
+        let session = AnySession::open(&plan, start, &mut std::iter::empty(), &mut tables);
         Ok(Self {
-            open: Some((session, Tables::default())),
+            open: Some((session.py_err(py)?, tables)),
             last_t: None,
         })
     }
@@ -163,7 +173,7 @@ impl PySession {
         let (session, mut tables) = self
             .open
             .take()
-            .ok_or_else(|| crate::errors::SchulerError::new_err("the session is finished"))?;
+            .ok_or_else(|| SchulerError::new_err("the session is finished"))?;
         let (finished, smoothed) = py.detach(|| session.finish(&mut tables)).py_err(py)?;
         let d = tables.take_dict(py)?;
         add_finished(py, &d, &finished, smoothed.as_deref())?;

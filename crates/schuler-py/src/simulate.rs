@@ -3,9 +3,10 @@
 //! collected into columns: the measured IMU samples, the truth, GNSS fixes, barometer
 //! readings and the true sensor errors, with the values the CLI's files hold.
 
-use crate::columns::{Columns, IMU, NAV};
+use crate::columns::{Columns, GNSS, IMU, NAV};
 use crate::errors::IntoPy;
 use anyhow::Context;
+use nalgebra::Vector3;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use schuler::imu::ImuSample;
@@ -28,24 +29,6 @@ const KINEMATICS: &[&str] = &[
     "f_z_mps2",
 ];
 
-/// Columns of the simulated GNSS fixes (`gnss.csv`'s, units in the names).
-const SIM_GNSS: &[&str] = &[
-    "t_s",
-    "lat_deg",
-    "lon_deg",
-    "h_m",
-    "std_n_m",
-    "std_e_m",
-    "std_d_m",
-    "vn_mps",
-    "ve_mps",
-    "vd_mps",
-    "std_vn_mps",
-    "std_ve_mps",
-    "std_vd_mps",
-    "outlier",
-];
-
 /// The simulated streams.
 struct Collected {
     imu: Columns,
@@ -54,6 +37,8 @@ struct Collected {
     gnss: Columns,
     baro: Columns,
     sensor_errors: Columns,
+    /// Whether the scenario simulates GNSS velocity measurements (`velocity_std`).
+    gnss_velocity: bool,
 }
 
 impl SimSink for Collected {
@@ -73,7 +58,14 @@ impl SimSink for Collected {
     }
 
     fn gnss(&mut self, g: &GnssFix) -> std::io::Result<()> {
-        let (p, s, v, sv) = (&g.pos, &g.pos_std, &g.v_n, &g.vel_std);
+        let (p, s) = (&g.pos, &g.pos_std);
+        // Without `velocity_std` the simulator measures no velocity (its velocity is
+        // the truth with a standard deviation of 0): NaN, as a fix without velocity.
+        let none = Vector3::repeat(f64::NAN);
+        let (v, sv) = match self.gnss_velocity {
+            true => (&g.v_n, &g.vel_std),
+            false => (&none, &none),
+        };
         let row = [
             p.lat.to_degrees(),
             p.lon.to_degrees(),
@@ -132,9 +124,10 @@ pub fn simulate_scenario<'py>(
         imu: Columns::new(IMU),
         truth: Columns::new(NAV),
         kinematics: Columns::new(KINEMATICS),
-        gnss: Columns::new(SIM_GNSS),
+        gnss: Columns::joined(&[GNSS, &["outlier"]]),
         baro: Columns::new(&["t_s", "h_m", "outlier"]),
         sensor_errors: Columns::new(crate::columns::SENSOR),
+        gnss_velocity: spec.gnss.as_ref().is_some_and(|g| g.velocity_std.is_some()),
     };
     py.detach(|| simulate(&spec, &mut c)).py_err(py)?;
     let d = PyDict::new(py);

@@ -83,3 +83,16 @@ def test_compare_equals_the_cli(cli, drive, tmp_path):
     np.testing.assert_array_equal(c.errors.iloc[:, :11].to_numpy(), errors.iloc[:, :11].to_numpy())
     with pytest.raises(schuler.SchulerError):
         schuler.compare(nav_out / "nav.txt", drive / "truth.nav", start=1e6)
+
+
+def test_fixes_without_simulated_velocity_have_none(sim):
+    """A scenario without `velocity_std` measures no velocity: its fixes' velocity
+    columns are NaN (as a file without them reads), so they aid by position alone;
+    with it, the velocity is measured and kept."""
+    assert sim.gnss["vn_mps"].notna().all() and (sim.gnss["std_vn_mps"] > 0).all()
+    text = "\n".join(l for l in DRIVE.read_text().splitlines() if not l.startswith("velocity_std"))
+    no_vel = schuler.simulate(text)
+    assert no_vel.gnss[["vn_mps", "std_vd_mps"]].isna().all().all()
+    r = schuler.navigate(no_vel.imu, gnss=no_vel.gnss, output_rate=1, end=300.0, **START)
+    c = r.summary["counts"]
+    assert c["gnss_position"] > 200 and c["gnss_velocity"] == 0

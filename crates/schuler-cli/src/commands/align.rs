@@ -8,7 +8,9 @@ use crate::formats::ImuReader;
 use crate::imu_input::ImuInputOptions;
 use crate::options::{EarthChoice, Triple};
 use anyhow::{Context, Result, bail};
+use schuler::align::AlignConfig;
 use schuler::earth::Geodetic;
+use schuler::filter::ImuNoise;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -38,14 +40,19 @@ pub struct Args {
     pub input: ImuInputOptions,
 }
 
-/// `schuler align`.
-pub fn run(args: Args) -> Result<()> {
+/// The checked configuration, noise model and base position of `args`.
+pub fn setup(args: &Args) -> Result<(AlignConfig, ImuNoise, Geodetic)> {
     let (cfg, noise) = args.options.resolve()?;
     let Triple([lat, lon, h]) = args.pos;
     if !(-90.0..=90.0).contains(&lat) {
         bail!("--pos: latitude {lat} deg is outside [-90, 90]");
     }
-    let pos = Geodetic::from_degrees(lat, lon, h);
+    Ok((cfg, noise, Geodetic::from_degrees(lat, lon, h)))
+}
+
+/// `schuler align`.
+pub fn run(args: Args) -> Result<()> {
+    let (cfg, noise, pos) = setup(&args)?;
     let read = args.input.read_options(args.start, None)?;
     let started = Instant::now();
     let mut reader = ImuReader::open(&args.imu, &read)?;

@@ -153,15 +153,15 @@ fn sig(x: f64) -> String {
 }
 
 /// Both fits of one channel.
-struct ChannelFit {
+pub struct ChannelFit {
     /// IEEE Std 952 terms.
-    ieee: Option<NoiseFit>,
+    pub ieee: Option<NoiseFit>,
     /// White noise, Gauss–Markov bias and random walk.
-    filter: Option<NoiseFit>,
+    pub filter: Option<NoiseFit>,
 }
 
 /// The two fits of each channel, one thread per channel.
-fn fit_channels(allan: &ImuAllan) -> Vec<ChannelFit> {
+pub fn fit_channels(allan: &ImuAllan) -> Vec<ChannelFit> {
     let opts = FitOptions {
         probability: PROBABILITY,
         ..FitOptions::default()
@@ -207,7 +207,7 @@ fn read(args: &Args) -> Result<(Vec<ImuSample>, Option<String>)> {
 /// What the log's means show of motion (module doc), as warnings naming `path`: the
 /// specific force against gravity, the rate against the Earth's, the 10-s blocks
 /// against their median ([`motion_warning`]).
-fn static_warnings(path: &Path, samples: &[ImuSample], allan: &ImuAllan) -> Vec<String> {
+pub fn static_warnings(path: &Path, samples: &[ImuSample], allan: &ImuAllan) -> Vec<String> {
     let file = path.display();
     let mut warnings = Vec::new();
     let f = allan.mean[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -363,7 +363,7 @@ fn fit_table(
 }
 
 /// The printed summary: the log, then both fits' tables per triad.
-fn summary(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String {
+pub fn summary(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String {
     let pts = &allan.channels[0].points;
     let (t0, t1) = (
         pts.first().map_or(0.0, |p| p.tau),
@@ -411,7 +411,7 @@ fn summary(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String {
 
 /// The 95 % interval of each point of `curve` under `fit`'s mix of terms (white noise's
 /// degrees of freedom without a fit).
-fn point_intervals(curve: &AllanCurve, fit: Option<&NoiseFit>) -> Vec<(f64, f64)> {
+pub fn point_intervals(curve: &AllanCurve, fit: Option<&NoiseFit>) -> Vec<(f64, f64)> {
     curve
         .points
         .iter()
@@ -605,7 +605,7 @@ fn common_correlation_time(fits: &[ChannelFit]) -> Option<f64> {
 /// any channel the instability keys are left out (`--imu-grade`'s stay). The bias
 /// priors (`gyro_bias_std`, `accel_bias_std`) are not the Allan curve's to tell: a
 /// constant bias has none.
-fn noise_toml(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String {
+pub fn noise_toml(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String {
     let mut s = format!(
         "# Noise of {} ({} samples at {} Hz) fitted by `schuler allan`: white noise, a \
          Gauss-Markov bias\n# and a bias random walk per axis; each key holds the largest \

@@ -291,7 +291,7 @@ pub fn config(args: &Args) -> Result<ChannelConfig> {
 }
 
 /// Adds the flag that a library error is about.
-fn explain(e: ChannelError) -> anyhow::Error {
+pub fn explain(e: ChannelError) -> anyhow::Error {
     let flag = match &e {
         ChannelError::StepTooCoarse { .. } => Some("--dt"),
         ChannelError::CannotLevel { .. } => Some("--level"),
@@ -381,7 +381,7 @@ fn ratio_of(a: &ErrorState, b: &ErrorState) -> Value {
 }
 
 /// The summary: inputs in SI, the measured Schuler period and trend, differences, peaks.
-fn summary(cfg: &ChannelConfig, run: &ChannelRun) -> Value {
+pub fn summary(cfg: &ChannelConfig, run: &ChannelRun) -> Value {
     let g = cfg.earth.gravitation(cfg.earth.radius);
     let theory = std::f64::consts::TAU * (cfg.earth.radius / g).sqrt();
     let fit = run.measured_oscillation();

@@ -419,10 +419,8 @@ pub(crate) fn progress_bar(imu: &Path) -> ProgressBar {
 }
 
 /// With `--align`: align on the log's first stages, print and write the result, and
-/// return the start it gives (the aligned state at the last aligned sample, its biases
-/// as the first estimates) and the samples after the alignment's end, the carrier of
-/// the start first. With aiding, the filter's prior becomes the alignment's
-/// ([`Prior::from_alignment`]).
+/// return the start it gives and the samples after the alignment's end
+/// ([`align_start`]).
 fn align_first<I, E>(
     settings: &NavSettings,
     opts: &AlignOptions,
@@ -434,12 +432,31 @@ where
     I: Iterator<Item = Result<ImuSample, E>>,
     E: std::error::Error + Send + Sync + 'static,
 {
+    let (start, head, a) = align_start(settings, opts, reader, aiding)?;
+    bar.suspend(|| print!("{}", crate::alignment::summary_text(&a, &[])));
+    crate::alignment::write_outputs(&settings.out, &a)?;
+    Ok((start, head))
+}
+
+/// The alignment of `--align` on the log's first stages: the start it gives (the
+/// aligned state at the last aligned sample, its biases as the first estimates), the
+/// samples after the alignment's end (the carrier of the start first) and the
+/// alignment itself. With aiding, the filter's prior becomes the alignment's
+/// ([`Prior::from_alignment`]).
+pub fn align_start<I, E>(
+    settings: &NavSettings,
+    opts: &AlignOptions,
+    reader: &mut I,
+    aiding: Option<&mut Aiding>,
+) -> Result<(Start, Vec<ImuSample>, schuler::align::Alignment)>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
     let (cfg, noise) = opts.resolve()?;
     let samples = crate::alignment::read_stage(reader, cfg.coarse + cfg.fine)?;
     let a = crate::alignment::align_on(settings.earth, settings.init_pos, &samples, &noise, &cfg)
         .with_context(|| format!("aligning {}", settings.imu.display()))?;
-    bar.suspend(|| print!("{}", crate::alignment::summary_text(&a, &[])));
-    crate::alignment::write_outputs(&settings.out, &a)?;
     if let Some(aiding) = aiding {
         let pos_std = aiding.filter.integration.init_pos_std;
         aiding.filter = Prior::from_alignment(&a, pos_std).apply_to(aiding.filter);
@@ -447,20 +464,61 @@ where
     let carrier = samples
         .partition_point(|s| s.t <= a.t_end + 1e-9)
         .saturating_sub(1);
-    Ok((Start::from_alignment(&a), samples[carrier..].to_vec()))
+    Ok((Start::from_alignment(&a), samples[carrier..].to_vec(), a))
 }
 
-/// With `--init gnss` or `gnss-any-heading`: the start in motion from the fixes and
-/// the IMU samples up to just past the fix it starts at ([`schuler::align::in_motion`]:
-/// the course's first long straight chord, or without a heading the first fix two
-/// seconds into the log), printed; the filter's prior becomes its standard deviations.
-/// Returns the start and the samples from its carrier on.
+/// With `--init gnss` or `gnss-any-heading`: the start in motion from the fixes
+/// ([`motion_start`]), printed. Returns the start and the samples from its carrier on.
 fn start_from_fixes<I, E>(
+    settings: &NavSettings,
+    reader: &mut I,
+    mut aiding: Option<&mut Aiding>,
+    init: InitChoice,
+) -> Result<(Start, Vec<ImuSample>)>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
+    let (start, head, m) = motion_start(settings, reader, aiding.as_deref_mut(), init)?;
+    let fixes = aiding.map(|a| &a.fixes[..]).unwrap_or_default();
+    let e = m.state.euler();
+    let heading = match init {
+        InitChoice::Gnss => format!(
+            "heading {:.2} ± {:.2} deg (the course: forward motion along the IMU's x axis assumed)",
+            e.heading_0_2pi().to_degrees(),
+            m.att_std.z.to_degrees()
+        ),
+        _ => format!("heading unknown: a bank of {BANK_MEMBERS} filters searches it"),
+    };
+    let fix_t = |i: usize| fixes.get(i).map_or(f64::NAN, |f| f.t);
+    println!(
+        "started in motion at t = {} s from the fixes at {} and {} s: {:.2} m/s, {heading}, roll {:.2} pitch {:.2} ± {:.2} deg",
+        m.state.t,
+        fix_t(m.fixes.0),
+        fix_t(m.fixes.1),
+        m.speed,
+        e.roll.to_degrees(),
+        e.pitch.to_degrees(),
+        m.att_std.x.to_degrees()
+    );
+    Ok((start, head))
+}
+
+/// The start in motion of `--init gnss` or `gnss-any-heading` from the fixes and the
+/// IMU samples up to just past the fix it starts at ([`schuler::align::in_motion`]:
+/// the course's first long straight chord, or without a heading the first fix two
+/// seconds into the log); the filter's prior becomes its standard deviations.
+/// Returns the start, the samples from its carrier on, and the start's details.
+pub fn motion_start<I, E>(
     settings: &NavSettings,
     reader: &mut I,
     aiding: Option<&mut Aiding>,
     init: InitChoice,
-) -> Result<(Start, Vec<ImuSample>)>
+) -> Result<(
+    Start,
+    Vec<ImuSample>,
+    schuler::align::in_motion::InMotionStart,
+)>
 where
     I: Iterator<Item = Result<ImuSample, E>>,
     E: std::error::Error + Send + Sync + 'static,
@@ -499,36 +557,18 @@ where
         _ => start_at_fix(&earth, &samples, fixes, i0, j, &cfg),
     }
     .with_context(context)?;
-    let e = m.state.euler();
-    let heading = match init {
-        InitChoice::Gnss => format!(
-            "heading {:.2} ± {:.2} deg (the course: forward motion along the IMU's x axis assumed)",
-            e.heading_0_2pi().to_degrees(),
-            m.att_std.z.to_degrees()
-        ),
-        _ => format!("heading unknown: a bank of {BANK_MEMBERS} filters searches it"),
-    };
-    println!(
-        "started in motion at t = {} s from the fixes at {} and {} s: {:.2} m/s, {heading}, roll {:.2} pitch {:.2} ± {:.2} deg",
-        m.state.t,
-        fixes[m.fixes.0].t,
-        fixes[m.fixes.1].t,
-        m.speed,
-        e.roll.to_degrees(),
-        e.pitch.to_degrees(),
-        m.att_std.x.to_degrees()
-    );
     let filter = &mut aiding.filter;
     *filter = Prior::from_motion(&m).apply_to(*filter);
-    Ok((Start::from_motion(&m), samples[m.sample..].to_vec()))
+    let head = samples[m.sample..].to_vec();
+    Ok((Start::from_motion(&m), head, m))
 }
 
 /// Members of the heading bank of `--init gnss-any-heading` (every 30°).
-const BANK_MEMBERS: usize = 12;
+pub const BANK_MEMBERS: usize = 12;
 
 /// Longest the heading bank runs before it keeps its most likely member [s] (it
 /// decides earlier once the data tell the headings apart).
-const BANK_SECONDS: f64 = 600.0;
+pub const BANK_SECONDS: f64 = 600.0;
 
 /// What a run starts from: the settings, the aiding, the start, and whether the
 /// heading is searched by the bank.

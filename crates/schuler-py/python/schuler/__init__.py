@@ -38,8 +38,15 @@ from . import _schuler
 from ._schuler import InputError, SchulerError
 
 __all__ = [
+    "AlignResult",
+    "AllanFit",
+    "ChannelResult",
     "Comparison",
+    "align",
     "allan",
+    "allan_fit",
+    "channel",
+    "closed_form",
     "InputError",
     "NavResult",
     "SchulerError",
@@ -199,6 +206,11 @@ class NavResult:
     measurement, reason, NIS, threshold), ``smoothed`` (with ``smooth=True``: the
     Rauch-Tung-Striebel trajectory with its standard deviations, else None),
     ``summary`` (counts, mean NIS per degree of freedom, hand-overs) and ``warnings``.
+    ``alignment``: with ``align=True``, the alignment at rest the run started from
+    (:class:`AlignResult`, ``align.json``'s content); ``start_in_motion``: with
+    ``init="gnss"`` or ``"gnss-any-heading"``, the start from the fixes (``t_s``,
+    ``speed_mps``, ``roll_deg``, ``pitch_deg``, ``yaw_deg``, ``att_std_deg`` about
+    north, east, down).
     """
 
     trajectory: pd.DataFrame
@@ -209,6 +221,8 @@ class NavResult:
     smoothed: Optional[pd.DataFrame] = None
     summary: Dict[str, Any] = field(default_factory=dict)
     warnings: List[str] = field(default_factory=list)
+    alignment: Optional["AlignResult"] = None
+    start_in_motion: Optional[Dict[str, Any]] = None
 
     @classmethod
     def _of(cls, d: Dict[str, Any]) -> "NavResult":
@@ -229,6 +243,8 @@ class NavResult:
             smoothed=None if smoothed is None else _frame(smoothed),
             summary=d.get("summary", {}),
             warnings=list(d.get("warnings", [])),
+            alignment=None if d.get("alignment") is None else AlignResult._of(d["alignment"]),
+            start_in_motion=d.get("start_in_motion"),
         )
 
 
@@ -254,6 +270,13 @@ def navigate(
     [deg], ``output_rate`` [Hz], ``start``/``end`` [s], ``lever_arm=(x, y, z)`` [m,
     FRD], ``imu_grade="tactical"``, ``gate``, ``arw="0.1 deg/sqrt(h)"``,
     ``scale_factors=True``, ``smooth=True``, ``mechanization``, ``earth``, ...
+
+    How the run starts, as ``schuler nav``: from ``init_pos``/``init_vel``/``init_att``;
+    with ``align=True`` after aligning at rest at ``init_pos`` on the log's first
+    ``coarse`` + ``fine`` seconds (the alignment options of :func:`align`; the result
+    carries it as ``alignment``); with ``init="gnss"`` in motion from the fixes (the
+    course gives the heading: a land vehicle driving forward), ``init="gnss-any-heading"``
+    the same with the heading found by a bank of 12 filters (both need ``gnss``).
     The GIL is released while the run goes on.
     """
     flags = _flags(options)
@@ -279,7 +302,8 @@ class Session:
     """A navigation session fed sample by sample or in blocks (live data, custom
     loops). ``options`` as :func:`navigate`'s (aids are pushed, not read from files);
     ``gnss=True``, ``baro=True`` set the filter up for the fixes and heights that will
-    be pushed (the vehicle aids' options, ``nhc=True`` and so on, likewise).
+    be pushed (the vehicle aids' options, ``nhc=True`` and so on, likewise). The
+    start is the given state: ``align`` and ``init="gnss"`` are :func:`navigate`'s.
 
     Aids pushed before the IMU reaches their time are applied at their own time;
     ``take()`` returns what was produced since the last call, ``finish()`` the rest
@@ -361,7 +385,7 @@ def simulate(scenario: Union[PathLike, str, Mapping[str, Any]]) -> SimResult:
 
 
 #: Columns of a navigation table (:func:`read_nav`, ``NavResult.trajectory``).
-NAV_COLUMNS = ("t_s", "lat_deg", "lon_deg", "h_m", "vn_mps", "ve_mps", "vd_mps", "roll_deg", "pitch_deg", "yaw_deg")
+NAV_COLUMNS = tuple(_schuler.NAV_COLUMNS)
 
 
 @dataclass
@@ -417,28 +441,8 @@ def allan(imu: Union[PathLike, Table], per_decade: float = 10.0, max_tau: Option
     return out
 
 
-#: Columns of a campaign's table (``runs.csv``), after ``seed``.
-CAMPAIGN_COLUMNS = (
-    "epochs",
-    "horizontal_rms_m",
-    "horizontal_max_m",
-    "cep_m",
-    "cep95_m",
-    "vertical_rms_m",
-    "vertical_max_m",
-    "velocity_rms_mps",
-    "roll_rms_deg",
-    "pitch_rms_deg",
-    "yaw_rms_deg",
-    "outage_horizontal_max_m",
-    "outage_vertical_max_m",
-    "nees_position",
-    "nees_velocity",
-    "nees_attitude",
-    "nees_epochs",
-    "mean_nis_per_dof",
-    "rejected",
-)
+#: Columns of a campaign's table (``runs.csv``), after ``seed``: the CLI's own list.
+CAMPAIGN_COLUMNS = tuple(_schuler.CAMPAIGN_COLUMNS)
 
 Campaign = Union[PathLike, str, Mapping[str, Any]]
 
@@ -487,3 +491,166 @@ def montecarlo(
     seeds = [(seed + k) % 2**64 for k in range(runs)]
     d = _schuler.montecarlo_seeds(seeds, flags=_flags(options), threads=threads, **_campaign_source(campaign))
     return _campaign_frame(d)
+
+
+@dataclass
+class AlignResult:
+    """What an alignment at rest gives (:func:`align`, ``NavResult.alignment``):
+    ``summary`` (``align.json``: ``roll_deg``, ``pitch_deg``, ``yaw_deg`` and their
+    ``_std_deg``; ``gyro_bias_dph`` [deg/h], ``accel_bias_mgal`` [mGal] and their
+    ``_std_``; ``t_start``, ``t_coarse``, ``t_end`` [s]; the coarse stage, the
+    predicted limits, observability, spikes, motion), ``convergence``
+    (``align_convergence.csv``: ``t_s``, the attitude's standard deviations [deg],
+    the gyro biases' [deg/h] and the accelerometer biases' [mGal] through the fine
+    stage) and ``report`` (the text ``schuler align`` prints, without run times)."""
+
+    summary: Dict[str, Any]
+    convergence: pd.DataFrame
+    report: str
+
+    @classmethod
+    def _of(cls, d: Mapping[str, Any]) -> "AlignResult":
+        return cls(summary=json.loads(d["summary"]), convergence=_frame(d["convergence"]), report=d["report"])
+
+    @property
+    def attitude_deg(self) -> "tuple[float, float, float]":
+        """Roll, pitch, yaw [deg] at the end of the alignment (yaw in [0, 360))."""
+        return tuple(self.summary[k] for k in ("roll_deg", "pitch_deg", "yaw_deg"))
+
+    @property
+    def attitude_std_deg(self) -> "tuple[float, float, float]":
+        """Standard deviations of roll, pitch, yaw [deg]."""
+        return tuple(self.summary[k] for k in ("roll_std_deg", "pitch_std_deg", "yaw_std_deg"))
+
+
+def align(imu: Union[PathLike, Table], pos: Sequence[float], **options: Any) -> AlignResult:
+    """Align a log recorded at rest, as ``schuler align``: coarse gyrocompassing, then
+    the Kalman filter on the invariants (Earth rate known, base still).
+
+    ``imu``: a file (read with the IMU input options) or a table as :func:`navigate`'s.
+    ``pos``: the base's latitude [deg], longitude [deg] and height [m]. ``options``:
+    ``schuler align``'s flags with underscores: ``coarse``, ``fine``, ``block``
+    (times with units, e.g. ``"190 s"``, ``"3 min"``; ``fine="0"`` for coarse only),
+    ``imu_grade``, ``heading`` (``"DEG"`` or ``"DEG,STD_DEG"``: an external heading
+    instead of gyrocompassing), ``max_heading_std`` [deg], ``start`` [s], ``earth``,
+    and the IMU input options. The GIL is released while it runs."""
+    flags = _flags(options) + [f"--pos={_value(pos)}"]
+    if isinstance(imu, (str, os.PathLike)):
+        return AlignResult._of(_schuler.align(flags + [f"--imu={os.fspath(imu)}"]))
+    cols, dt = _imu(imu)
+    return AlignResult._of(_schuler.align(flags + ["--imu=<imu array>"], imu=cols, imu_dt=dt))
+
+
+@dataclass
+class AllanFit:
+    """What :func:`allan_fit` gives (``schuler allan``'s outputs): ``curves``
+    (``allan.csv``: ``tau_s``, ``m``, per channel ``gyro_{x,y,z}_radps`` or
+    ``accel_{x,y,z}_mps2``, its 95 % interval ``..._lo_...``, ``..._hi_...`` and the
+    IEEE 952 fit ``..._fit_...``), ``fits`` (one row per channel, model and term:
+    ``model`` ``ieee952`` (terms ``N``, ``B``, ``K``, ``Q``) or ``gauss_markov``
+    (``N``, ``sigma``, ``K`` and the correlation time ``T`` [s]); ``value``, ``lo``,
+    ``hi`` in SI (gyros: N rad/sqrt(s), B and sigma rad/s, K rad/s/sqrt(s), Q rad;
+    accelerometers: N m/s/sqrt(s), B and sigma m/s^2, K m/s^2/sqrt(s), Q m/s) and the
+    fit's ``chi2_per_dof``), ``report`` (the tables it prints, engineering units),
+    ``noise_toml`` (``imu_noise.toml``: the filter model as ``schuler nav``'s
+    ``[aiding]`` keys) and ``warnings`` (a log that moves or has gaps)."""
+
+    curves: pd.DataFrame
+    fits: pd.DataFrame
+    report: str
+    noise_toml: str
+    warnings: List[str]
+
+
+def allan_fit(imu: Union[PathLike, Table], **options: Any) -> AllanFit:
+    """Allan deviations and their noise fits, as ``schuler allan``: the IEEE Std 952
+    terms (random walk ``N``, bias instability ``B``, rate random walk ``K``,
+    quantization ``Q``) and the filter's model (white noise, a Gauss-Markov bias of
+    correlation time ``T``, a bias random walk), each with its 95 % interval.
+    ``imu``: a file or a table as :func:`navigate`'s; ``options``: ``max_tau`` (a
+    time with units, default a tenth of the log), ``start``, ``end`` [s] and the IMU
+    input options (files only). The GIL is released while it runs."""
+    flags = _flags(options)
+    if isinstance(imu, (str, os.PathLike)):
+        d = _schuler.allan_fit([os.fspath(imu)] + flags)
+    else:
+        cols, dt = _imu(imu)
+        d = _schuler.allan_fit(["<imu array>"] + flags, imu=cols, imu_dt=dt)
+    curves = _frame(d["curves"])
+    curves["m"] = curves["m"].astype(np.int64)
+    fits = _frame(d["fits"])[["channel", "model", "term", "value", "lo", "hi", "chi2_per_dof"]]
+    return AllanFit(curves=curves, fits=fits, report=d["report"], noise_toml=d["noise_toml"], warnings=list(d["warnings"]))
+
+
+@dataclass
+class ChannelResult:
+    """What :func:`channel` gives (``schuler channel``'s files): ``errors``
+    (``errors.csv``: ``t_s``; position ``dr_m``, velocity ``dv_mps`` and vertical
+    ``alpha_rad`` errors of the nonlinear system, then of the linear model
+    (``_linear_``) and of the closed form (``_closed_``, NaN when the inputs are not
+    constant)) and ``summary`` (``summary.json``: inputs in SI, the measured Schuler
+    period, largest differences, peaks)."""
+
+    errors: pd.DataFrame
+    summary: Dict[str, Any]
+
+
+def channel(**options: Any) -> ChannelResult:
+    """The textbook's single-channel INS or SINS, as ``schuler channel``: the nonlinear
+    ideal and perturbed systems (6)/(9) or (7)/(26), the linear error model (13)/(28)
+    and the closed form (18)-(23) side by side. ``options``: its flags with
+    underscores, values with units as the CLI takes them (``system="sins"``,
+    ``accel_bias="1e-3m/s^2"``, ``gyro_drift="0.01deg/h"``, ``init_tilt="20arcsec"``,
+    ``init_vel_error``, ``init_pos_error``, ``level=True``, ``earth_rate=...``,
+    ``turn=["1h:180deg"]``, ``rotate``, ``speed``, ``accelerate``, ``duration="4h"``,
+    ``dt``, ``radius``, ``g``). A list gives a repeated flag. The GIL is released
+    while it runs."""
+    flags: List[str] = []
+    for name, v in options.items():
+        if name in ("turn", "accelerate") and isinstance(v, (list, tuple)):
+            flags += [f"--{name}={_value(x)}" for x in v]
+        else:
+            flags += _flags({name: v})
+    d = _schuler.channel(flags + ["--out=<none>"])
+    return ChannelResult(errors=_frame(d["errors"]), summary=json.loads(d["summary"]))
+
+
+def closed_form(
+    t: Any,
+    accel_bias: float = 0.0,
+    drift: float = 0.0,
+    alpha0: float = 0.0,
+    dv0: float = 0.0,
+    dr0: float = 0.0,
+    dh0: float = 0.0,
+    dvh0: float = 0.0,
+    vertical_accel_bias: float = 0.0,
+    radius: float = 6.371e6,
+    g: float = 9.81,
+) -> pd.DataFrame:
+    """The textbook's closed-form errors at the times ``t`` [s] (an array), SI
+    throughout. Horizontal channel, general solution (18)/(19) of (13) for constant
+    inputs (each alone gives (20)-(23)): accelerometer bias ``accel_bias`` [m/s^2],
+    platform drift ``drift`` [rad/s] (a strapdown gyro's drift with its sign
+    reversed), initial vertical error ``alpha0`` [rad], velocity error ``dv0``
+    [m/s], position error ``dr0`` [m]: columns ``dr_m``, ``dv_mps``, ``alpha_rad``
+    oscillating with the Schuler period ``2 pi sqrt(radius / g)`` (84.4 min for the
+    defaults). Free vertical channel (32) from ``dh0`` [m], ``dvh0`` [m/s] and a
+    vertical accelerometer error ``vertical_accel_bias`` [m/s^2]: ``dh_m``,
+    ``dvh_mps``, growing with e-fold time ``1 / (sqrt(2) omega0)`` (570 s). On a sphere
+    of ``radius`` [m] with vertical specific force ``g`` [m/s^2]."""
+    return _frame(
+        _schuler.closed_form(
+            _f64(np.atleast_1d(t)),
+            accel_bias=float(accel_bias),
+            drift=float(drift),
+            alpha0=float(alpha0),
+            dv0=float(dv0),
+            dr0=float(dr0),
+            dh0=float(dh0),
+            dvh0=float(dvh0),
+            vertical_accel_bias=float(vertical_accel_bias),
+            radius=float(radius),
+            g=float(g),
+        )
+    )

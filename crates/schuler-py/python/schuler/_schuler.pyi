@@ -16,6 +16,11 @@ class InputError(SchulerError):
     field: Optional[str]
     kind: str
 
+#: Columns of a campaign's table (``runs.csv``) after ``seed``.
+CAMPAIGN_COLUMNS: List[str]
+#: Columns of a navigation table: ``t_s``, ``lat_deg`` [deg], ... ``yaw_deg`` [deg].
+NAV_COLUMNS: List[str]
+
 def read_imu(path: str, flags: List[str]) -> Dict[str, F64]: ...
 def read_gnss(path: str, flags: List[str]) -> Dict[str, F64]: ...
 def read_baro(path: str) -> Dict[str, List[float]]: ...
@@ -75,3 +80,36 @@ def montecarlo_seeds(
     flags: List[str] = ...,
     threads: Optional[int] = None,
 ) -> Dict[str, Any]: ...
+def allan_fit(
+    flags: List[str], imu: Optional[Sequence[F64]] = None, imu_dt: Optional[F64] = None
+) -> Dict[str, Any]:
+    """``schuler allan`` (``flags[0]`` the file): ``curves``, ``fits`` (SI),
+    ``report``, ``noise_toml``, ``warnings``."""
+    ...
+
+def align(
+    flags: List[str], imu: Optional[Sequence[F64]] = None, imu_dt: Optional[F64] = None
+) -> Dict[str, Any]:
+    """``schuler align``: ``summary`` (align.json text), ``convergence`` [s, deg,
+    deg/h, mGal], ``report``."""
+    ...
+
+def channel(flags: List[str]) -> Dict[str, Any]:
+    """``schuler channel``: ``errors`` [s, m, m/s, rad], ``summary`` (JSON text)."""
+    ...
+
+def closed_form(
+    t: F64,
+    accel_bias: float = 0.0,
+    drift: float = 0.0,
+    alpha0: float = 0.0,
+    dv0: float = 0.0,
+    dr0: float = 0.0,
+    dh0: float = 0.0,
+    dvh0: float = 0.0,
+    vertical_accel_bias: float = 0.0,
+    radius: float = 6.371e6,
+    g: float = 9.81,
+) -> Dict[str, F64]:
+    """(18)-(23) and (32) at ``t`` [s], SI in and out."""
+    ...
