@@ -404,8 +404,9 @@ fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {
 
 /// The flag of `nav` that sets a session configuration field.
 fn flag_of(field: &str) -> &'static str {
-    const FLAGS: [(&str, &str); 40] = [
+    const FLAGS: [(&str, &str); 41] = [
         ("mechanization.auto_latitude", "--auto-latitude"),
+        ("filter.error_model", "--error-model"),
         ("mechanization.hysteresis", "--auto-hysteresis"),
         ("output_rate", "--output-rate"),
         ("filter.integration.noise.arw", "--arw"),

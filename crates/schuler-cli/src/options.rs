@@ -126,6 +126,23 @@ impl LayoutChoice {
     }
 }
 
+/// The filter's error model (`--error-model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ErrorModelArg {
+    /// The psi-angle model: position, velocity, attitude errors, gyro and
+    /// accelerometer biases (15 states).
+    #[default]
+    Psi15,
+    /// psi15 with gyro and accelerometer scale factors (21 states, as
+    /// `--scale-factors`).
+    Psi21,
+    /// The flight-test paper's 18 states (seed 003): velocity, the navigation and
+    /// orientation quaternions' errors, drifts, biases, height; wander mechanization
+    /// only, GNSS position and velocity only, no lever arm.
+    Seed18,
+}
+
 /// Which strapdown mechanization integrates the log (`--mechanization`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]

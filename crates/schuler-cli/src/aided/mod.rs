@@ -14,7 +14,7 @@ use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use report::ReportSettings;
 use schuler::filter::{GnssFix, ImuNoise, IntegrationConfig, SensorEstimates};
-use schuler::session::FilterConfig;
+use schuler::session::{ErrorModelChoice, FilterConfig};
 use schuler::units::{Dimension, parse_as_or_si};
 use std::path::{Path, PathBuf};
 use vehicle::VehicleReadings;
@@ -165,6 +165,11 @@ pub struct AidingOptions {
     #[arg(long)]
     #[serde(default)]
     pub scale_factors: bool,
+    /// The filter's error model: psi15 (default), psi21 (as --scale-factors) or
+    /// seed18, the flight-test paper's 18 states (needs --mechanization wander; GNSS
+    /// position and velocity only, no lever arm, no smoother).
+    #[arg(long, value_name = "MODEL")]
+    pub error_model: Option<crate::options::ErrorModelArg>,
     /// Also write the Rauch–Tung–Striebel smoothed trajectory (forward-backward) at
     /// the output rate into `OUT/smoothed/` (the forward result stays in `OUT/`).
     #[arg(long)]
@@ -348,6 +353,7 @@ impl AidingOptions {
             gnss_min_quality,
             gnss_time_offset,
             gnss_vel,
+            error_model,
             gnss_vel_std,
             lever_arm,
             gate,
@@ -480,6 +486,7 @@ impl AidingOptions {
         let (vehicle_cfg, vehicle) = vehicle::resolve(self, &noise)?;
         let mut integration = self.integration(noise)?;
         integration.baro = baro_std.map(|(_, bias)| (bias, 0.0));
+        let error_model = self.error_model(&mut integration)?;
         Ok(Some(Aiding {
             vehicle,
             filter: FilterConfig {
@@ -488,6 +495,7 @@ impl AidingOptions {
                 smooth: self.smooth,
                 vehicle: vehicle_cfg,
                 att_bias_cov: None,
+                error_model,
             },
             names: OutputNames::SCHULER,
             initial_errors: Default::default(),
@@ -716,6 +724,23 @@ impl AidingOptions {
     }
 
     /// The filter's settings (without the barometer).
+    /// The library's error model of `--error-model` (psi21 turns the scale-factor
+    /// states on in `integration`).
+    fn error_model(&self, integration: &mut IntegrationConfig) -> Result<ErrorModelChoice> {
+        use crate::options::ErrorModelArg;
+        Ok(match self.error_model.unwrap_or_default() {
+            ErrorModelArg::Psi15 if self.scale_factors => {
+                bail!("--error-model psi15 has no scale factors; --scale-factors is psi21")
+            }
+            ErrorModelArg::Psi15 => ErrorModelChoice::Psi,
+            ErrorModelArg::Psi21 => {
+                integration.scale_factors = true;
+                ErrorModelChoice::Psi
+            }
+            ErrorModelArg::Seed18 => ErrorModelChoice::Seed18,
+        })
+    }
+
     fn integration(&self, noise: ImuNoise) -> Result<IntegrationConfig> {
         let gate = match self.gate {
             None => schuler::filter::Gate::Level(1e-4),

@@ -508,39 +508,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     /// Mechanize a sample during which GNSS fixes may fall: fixes from `fixes` with
     /// times up to the sample's end are applied at their own times.
     pub fn step_with_fixes<F: FixSource>(&mut self, raw: &ImuSample, fixes: &mut F) {
-        let tol = 1e-3 * raw.dt.max(1e-9);
-        let mut rest = Some(*raw);
-        while let Some(ft) = fixes.next_time() {
-            let now = self.mech.state().t;
-            if ft < now - tol {
-                fixes.pop_fix();
-                self.skip(ft, SkipReason::BeforeImu);
-                continue;
-            }
-            if ft <= now + tol {
-                if let Some(f) = fixes.pop_fix() {
-                    self.update_gnss(&f);
-                }
-                continue;
-            }
-            let Some(r) = rest else { break };
-            if ft > r.t + tol {
-                break;
-            }
-            let Some(f) = fixes.pop_fix() else { break };
-            if ft < r.t - tol {
-                let (a, b) = split(&r, ft);
-                self.step(&a);
-                rest = Some(b);
-            } else {
-                self.step(&r);
-                rest = None;
-            }
-            self.update_gnss(&f);
-        }
-        if let Some(r) = rest {
-            self.step(&r);
-        }
+        step_with_fixes(self, raw, fixes);
     }
 
     /// Continue on another mechanization of the same instant (the NED <-> wander
@@ -794,6 +762,74 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         };
         self.propagate();
         self.apply(reading.t, m)
+    }
+}
+
+/// A filter that [`step_with_fixes`] drives: it steps samples, applies GNSS fixes and
+/// records the ones it cannot use (the psi-angle [`Integrator`] and the 18-state
+/// [`super::seed18::Seed18`]).
+pub trait FixConsumer {
+    /// The mechanization's time [s].
+    fn now(&self) -> f64;
+    /// Mechanize one sample with no fix inside it.
+    fn step_sample(&mut self, s: &ImuSample);
+    /// Apply a fix now.
+    fn apply_fix(&mut self, f: &GnssFix);
+    /// Record a fix that could not be used.
+    fn skip_fix(&mut self, t: f64, reason: SkipReason);
+}
+
+impl<M: ErrorFrame, E: EarthModel> FixConsumer for Integrator<M, E> {
+    fn now(&self) -> f64 {
+        self.mech.state().t
+    }
+    fn step_sample(&mut self, s: &ImuSample) {
+        self.step(s);
+    }
+    fn apply_fix(&mut self, f: &GnssFix) {
+        self.update_gnss(f);
+    }
+    fn skip_fix(&mut self, t: f64, reason: SkipReason) {
+        self.skip(t, reason);
+    }
+}
+
+/// Mechanize a sample of `c` during which GNSS fixes may fall: fixes from `fixes`
+/// with times up to the sample's end are applied at their own times (the sample is
+/// split there, [`split`]); fixes before the mechanization's time are skipped.
+pub fn step_with_fixes<C: FixConsumer, F: FixSource>(c: &mut C, raw: &ImuSample, fixes: &mut F) {
+    let tol = 1e-3 * raw.dt.max(1e-9);
+    let mut rest = Some(*raw);
+    while let Some(ft) = fixes.next_time() {
+        let now = c.now();
+        if ft < now - tol {
+            fixes.pop_fix();
+            c.skip_fix(ft, SkipReason::BeforeImu);
+            continue;
+        }
+        if ft <= now + tol {
+            if let Some(f) = fixes.pop_fix() {
+                c.apply_fix(&f);
+            }
+            continue;
+        }
+        let Some(r) = rest else { break };
+        if ft > r.t + tol {
+            break;
+        }
+        let Some(f) = fixes.pop_fix() else { break };
+        if ft < r.t - tol {
+            let (a, b) = split(&r, ft);
+            c.step_sample(&a);
+            rest = Some(b);
+        } else {
+            c.step_sample(&r);
+            rest = None;
+        }
+        c.apply_fix(&f);
+    }
+    if let Some(r) = rest {
+        c.step_sample(&r);
     }
 }
 

@@ -12,6 +12,7 @@
 //! - [`integration`]: the loosely coupled INS/GNSS filter loop;
 //! - [`smoother`]: the Rauch–Tung–Striebel backward pass, over [`spill`]'s records
 //!   (memory up to a budget, then a temporary file);
+//! - [`seed18`]: the flight-test paper's 18-state model on the wander mechanization;
 //! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
 //!   innovation gate.
 
@@ -22,6 +23,7 @@ pub mod kalman;
 pub mod layout;
 pub mod measurement;
 pub mod noise;
+pub mod seed18;
 pub mod smoother;
 pub mod spill;
 pub mod vehicle;

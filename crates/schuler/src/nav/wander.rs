@@ -271,7 +271,7 @@ fn compose_accurate(hi: &mut Quaternion<f64>, lo: &mut Quaternion<f64>, eps: &Ve
 /// `g_N n + g_E (d × n)` with unit north `n = u_xy / |u_xy|`; zero horizontal part
 /// exactly on the axis, where an axisymmetric field has none.
 #[inline]
-fn gravity_w(g_n: &Vector3<f64>, u_w: &Vector3<f64>) -> Vector3<f64> {
+pub(crate) fn gravity_w(g_n: &Vector3<f64>, u_w: &Vector3<f64>) -> Vector3<f64> {
     let cos_lat = (u_w.x * u_w.x + u_w.y * u_w.y).sqrt();
     if (g_n.x != 0.0 || g_n.y != 0.0) && cos_lat > 0.0 {
         let inv = 1.0 / cos_lat;

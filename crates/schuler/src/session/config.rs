@@ -167,6 +167,18 @@ impl Default for VehicleConfig {
     }
 }
 
+/// The filter's error model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ErrorModelChoice {
+    /// The psi-angle model ([`crate::filter::error_model`]): 15 states, 21 with
+    /// [`IntegrationConfig::scale_factors`].
+    #[default]
+    Psi,
+    /// The flight-test paper's 18 states ([`crate::filter::seed18`]), on the wander
+    /// mechanization only, with GNSS position and velocity only.
+    Seed18,
+}
+
 /// The error-state filter of an aided session.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FilterConfig {
@@ -183,6 +195,8 @@ pub struct FilterConfig {
     /// and accelerometer biases, overriding `integration`'s standard deviations of
     /// these (an alignment's, [`super::Prior::from_alignment`]).
     pub att_bias_cov: Option<SMatrix<f64, 9, 9>>,
+    /// The error model (psi-angle by default).
+    pub error_model: ErrorModelChoice,
 }
 
 impl FilterConfig {
@@ -195,6 +209,7 @@ impl FilterConfig {
             smooth: false,
             vehicle: VehicleConfig::default(),
             att_bias_cov: None,
+            error_model: ErrorModelChoice::Psi,
         }
     }
 }
@@ -428,6 +443,37 @@ impl SessionConfig {
         }
         if let Some(f) = &self.filter {
             f.validate()?;
+            if f.error_model == ErrorModelChoice::Seed18 {
+                self.validate_seed18(f)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// What the 18-state model needs: the wander mechanization throughout (it has no
+    /// NED form to hand over to), GNSS only, no smoother.
+    fn validate_seed18(&self, f: &FilterConfig) -> Result<(), ConfigError> {
+        let field = "filter.error_model";
+        if self.mechanization.choice != MechanizationChoice::Wander {
+            return Err(ConfigError::new(
+                field,
+                "seed18 runs only on the wander mechanization (its states are the wander quaternions); choose the wander mechanization",
+            ));
+        }
+        if let Err(e) = crate::filter::seed18::check(&f.integration) {
+            return Err(ConfigError::new(field, e.to_string()));
+        }
+        let refuse = |what: &str| {
+            Err(ConfigError::new(
+                field,
+                format!("seed18 has no {what}; use psi15 or psi21"),
+            ))
+        };
+        if f.smooth {
+            return refuse("smoother");
+        }
+        if f.vehicle.any() {
+            return refuse("vehicle aids (zero velocity, non-holonomic, odometer, heading)");
         }
         Ok(())
     }

@@ -11,6 +11,7 @@ use super::config::{MechanizationChoice, MechanizationConfig, MechanizationKind}
 use super::output::Handover;
 use crate::earth::EarthModel;
 use crate::filter::Integrator;
+use crate::filter::seed18::Seed18;
 use crate::nav::{ErrorFrame, LocalLevel, Mechanization, NavState, Wander};
 use nalgebra::Vector3;
 
@@ -63,6 +64,8 @@ pub(crate) enum Core<E: EarthModel> {
     Wander(Wander<E>),
     FilterNed(Integrator<LocalLevel<E>, E>),
     FilterWander(Integrator<Wander<E>, E>),
+    /// The 18-state filter (wander only, never handed over).
+    FilterSeed18(Box<Seed18<E>>),
 }
 
 /// When `auto` hands over: above `sin_enter` to wander, below `sin_leave` to NED.
@@ -106,7 +109,9 @@ impl<E: EarthModel> Core<E> {
     pub fn kind(&self) -> MechanizationKind {
         match self {
             Core::Ned(_) | Core::FilterNed(_) => MechanizationKind::Ned,
-            Core::Wander(_) | Core::FilterWander(_) => MechanizationKind::Wander,
+            Core::Wander(_) | Core::FilterWander(_) | Core::FilterSeed18(_) => {
+                MechanizationKind::Wander
+            }
         }
     }
 
@@ -116,6 +121,7 @@ impl<E: EarthModel> Core<E> {
             Core::Wander(m) => Navigating::sin_lat(m),
             Core::FilterNed(i) => i.mechanization().sin_lat(),
             Core::FilterWander(i) => Navigating::sin_lat(i.mechanization()),
+            Core::FilterSeed18(i) => Navigating::sin_lat(i.mechanization()),
         }
     }
 
@@ -125,6 +131,7 @@ impl<E: EarthModel> Core<E> {
             Core::Wander(m) => m.read_out(),
             Core::FilterNed(i) => i.mechanization().read_out(),
             Core::FilterWander(i) => i.mechanization().read_out(),
+            Core::FilterSeed18(i) => i.mechanization().read_out(),
         }
     }
 
@@ -135,6 +142,9 @@ impl<E: EarthModel> Core<E> {
             Core::Wander(m) => Core::Ned(m.to_local_level()),
             Core::FilterNed(i) => Core::FilterWander(i.hand_over(Wander::from_local_level)),
             Core::FilterWander(i) => Core::FilterNed(i.hand_over(Wander::to_local_level)),
+            // The configuration refuses a hand-over with the 18-state model
+            // (`SessionConfig::validate`): it stays.
+            Core::FilterSeed18(i) => Core::FilterSeed18(i),
         };
         let (state, ..) = core.read_out();
         let handover = Handover {

@@ -30,8 +30,8 @@ mod vehicle;
 
 pub use aid::Aid;
 pub use config::{
-    BaroLoopConfig, ConfigError, Envelope, FilterConfig, MechanizationChoice, MechanizationConfig,
-    MechanizationKind, RestConfig, RestSource, SessionConfig, VehicleConfig,
+    BaroLoopConfig, ConfigError, Envelope, ErrorModelChoice, FilterConfig, MechanizationChoice,
+    MechanizationConfig, MechanizationKind, RestConfig, RestSource, SessionConfig, VehicleConfig,
 };
 pub use heading_bank::{Chosen, HeadingBank};
 pub use output::{Decimator, Epoch, Event, FilterEpoch, Handover, Snapshot};
@@ -45,8 +45,9 @@ use vehicle::VehicleRun;
 use crate::analysis::errors::NavRecord;
 use crate::channel::vertical::DetectorCounts;
 use crate::earth::EarthModel;
-use crate::filter::integration::{Counts, SkipReason, Skipped};
+use crate::filter::integration::{Counts, Innovation, Rejected, SkipReason, Skipped};
 use crate::filter::measurement::Kind;
+use crate::filter::seed18::Seed18;
 use crate::filter::smoother::SmoothedTrajectory;
 use crate::filter::{Integrator, Layout};
 use crate::imu::ImuSample;
@@ -443,6 +444,7 @@ impl<E: EarthModel> Session<E> {
         match self.core.as_mut() {
             Some(Core::FilterNed(i)) => run.finish_filter(i),
             Some(Core::FilterWander(i)) => run.finish_filter(i),
+            Some(Core::FilterSeed18(i)) => run.finish_seed18(i),
             _ => {
                 let q = &mut run.queues;
                 let after = if run.done.is_some() {
@@ -492,6 +494,11 @@ impl<E: EarthModel> Session<E> {
         let end = match &mut core {
             Core::FilterNed(i) => filter_end(i, &run.cfg)?,
             Core::FilterWander(i) => filter_end(i, &run.cfg)?,
+            Core::FilterSeed18(i) => FilterEnd {
+                counts: i.counts,
+                estimates: Some(i.estimates()),
+                ..FilterEnd::default()
+            },
             _ => FilterEnd {
                 counts: Counts {
                     skipped: run.skipped_free,
@@ -541,6 +548,7 @@ impl<E: EarthModel> Session<E> {
             Core::Wander(m) => run.free_step(m, estimates, s),
             Core::FilterNed(i) => run.filter_step(&self.earth, i, s),
             Core::FilterWander(i) => run.filter_step(&self.earth, i, s),
+            Core::FilterSeed18(i) => run.seed18_step(&self.earth, i, s),
         }
         run.samples += 1;
         run.done = Some((s.t, s.dt));
@@ -582,6 +590,7 @@ fn epoch_of<E: EarthModel>(core: &Core<E>) -> Epoch {
         filter: match core {
             Core::FilterNed(i) => Some(FilterEpoch::of(i)),
             Core::FilterWander(i) => Some(FilterEpoch::of(i)),
+            Core::FilterSeed18(i) => Some(FilterEpoch::of_seed18(i)),
             _ => None,
         },
     }
@@ -671,6 +680,19 @@ impl Loop {
             (None, false) => Core::Ned(Navigating::start(earth, init)),
             (None, true) => Core::Wander(Navigating::start(earth, init)),
             (Some(f), false) => Core::FilterNed(self.start_filter(earth, init, start, &f)),
+            (Some(f), true) if f.error_model == ErrorModelChoice::Seed18 => {
+                match self.start_seed18(earth, init, start, &f) {
+                    Ok(i) => Core::FilterSeed18(Box::new(i)),
+                    // `SessionConfig::validate` has refused what the model lacks.
+                    Err(e) => {
+                        self.failure = Some(SessionError::Config(ConfigError::new(
+                            "filter.error_model",
+                            e.to_string(),
+                        )));
+                        Core::Wander(Navigating::start(earth, init))
+                    }
+                }
+            }
             (Some(f), true) => Core::FilterWander(self.start_filter(earth, init, start, &f)),
         };
         let compensated = start.estimates.compensate(s);
@@ -679,6 +701,7 @@ impl Loop {
             Core::Wander(m) => m.prime(&compensated),
             Core::FilterNed(i) => i.prime(s),
             Core::FilterWander(i) => i.prime(s),
+            Core::FilterSeed18(i) => i.prime(s),
         }
         self.first_mechanization = core.kind();
         self.t_first = s.t;
@@ -690,6 +713,9 @@ impl Loop {
         }
         if let (Some(taker), Core::FilterWander(i)) = (self.snapshots.as_mut(), &core) {
             taker.after_sample(&earth, i, s.t, s.dt);
+        }
+        if let (Some(taker), Core::FilterSeed18(i)) = (self.snapshots.as_mut(), &core) {
+            taker.after_sample(&earth, i.as_ref(), s.t, s.dt);
         }
         core
     }
@@ -715,6 +741,23 @@ impl Loop {
         } else {
             integ
         }
+    }
+
+    /// The 18-state filter at the start state, with the start's sensor estimates
+    /// standing as the compensation and the alignment's prior if any.
+    fn start_seed18<E: EarthModel>(
+        &self,
+        earth: E,
+        init: NavState,
+        start: &Start,
+        f: &FilterConfig,
+    ) -> Result<Seed18<E>, crate::filter::seed18::Unsupported> {
+        let mut s = Seed18::new(Navigating::start(earth, init), f.integration)?
+            .with_estimates(start.estimates);
+        if let Some(p) = &f.att_bias_cov {
+            s = s.with_attitude_bias_covariance(p);
+        }
+        Ok(s)
     }
 
     /// Record an output epoch (and the smoother's output instant).
@@ -821,8 +864,25 @@ impl Loop {
 
     /// Move what the filter recorded into the events.
     fn take_records<M: ErrorFrame, E: EarthModel>(&mut self, integ: &mut Integrator<M, E>) {
-        if !integ.innovations.is_empty() {
-            for i in integ.innovations.drain(..) {
+        self.take(
+            &mut integ.innovations,
+            &mut integ.rejected,
+            &mut integ.skipped,
+            &mut integ.gate_resets,
+        );
+    }
+
+    /// Move a filter's records (tested, refused, skipped measurements, gate resets)
+    /// into the events.
+    fn take(
+        &mut self,
+        innovations: &mut Vec<Innovation>,
+        rejected: &mut Vec<Rejected>,
+        skipped: &mut Vec<Skipped>,
+        gate_resets: &mut Vec<(f64, f64)>,
+    ) {
+        if !innovations.is_empty() {
+            for i in innovations.drain(..) {
                 if i.accepted {
                     self.nis.0 += i.nis;
                     self.nis.1 += i.z.len();
@@ -830,23 +890,48 @@ impl Loop {
                 self.events.push_back(Event::Measurement(i));
             }
         }
-        if !integ.rejected.is_empty() {
-            self.events
-                .extend(integ.rejected.drain(..).map(Event::Refused));
+        if !rejected.is_empty() {
+            self.events.extend(rejected.drain(..).map(Event::Refused));
         }
-        if !integ.skipped.is_empty() {
-            self.events
-                .extend(integ.skipped.drain(..).map(Event::Skipped));
+        if !skipped.is_empty() {
+            self.events.extend(skipped.drain(..).map(Event::Skipped));
         }
-        if !integ.gate_resets.is_empty() {
-            self.gate_resets += integ.gate_resets.len() as u64;
+        if !gate_resets.is_empty() {
+            self.gate_resets += gate_resets.len() as u64;
             self.events.extend(
-                integ
-                    .gate_resets
+                gate_resets
                     .drain(..)
                     .map(|(t, nis)| Event::GateReset { t, nis }),
             );
         }
+    }
+
+    /// One sample under the 18-state filter: GNSS inside it (the configuration
+    /// allows no other aid); its records become events.
+    fn seed18_step<E: EarthModel>(&mut self, earth: &E, f: &mut Seed18<E>, s: &ImuSample) {
+        f.step_with_fixes(s, &mut self.queues.gnss);
+        self.take_seed18(f);
+        if let Some(taker) = self.snapshots.as_mut() {
+            taker.after_sample(earth, f, s.t, s.dt);
+        }
+    }
+
+    fn take_seed18<E: EarthModel>(&mut self, f: &mut Seed18<E>) {
+        self.take(
+            &mut f.innovations,
+            &mut f.rejected,
+            &mut f.skipped,
+            &mut f.gate_resets,
+        );
+    }
+
+    /// At the end of the input under the 18-state filter: fixes after the last
+    /// sample are skipped.
+    fn finish_seed18<E: EarthModel>(&mut self, f: &mut Seed18<E>) {
+        while let Some(fix) = self.queues.gnss.pop_front() {
+            f.skip(fix.t, SkipReason::AfterImu);
+        }
+        self.take_seed18(f);
     }
 
     /// At the end of the input: aids after the last sample are skipped.

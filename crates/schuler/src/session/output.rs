@@ -9,6 +9,7 @@ use crate::earth::EarthModel;
 use crate::filter::integration::{Innovation, Rejected, Skipped};
 use crate::filter::kalman::std3;
 use crate::filter::measurement::Kind;
+use crate::filter::seed18::Seed18;
 use crate::filter::{Integrator, Layout, SensorEstimates};
 use crate::nav::{ErrorFrame, NavState};
 use nalgebra::{Matrix3, Vector3};
@@ -63,6 +64,57 @@ impl FilterEpoch {
                 std(l.accel_scale),
             ],
         }
+    }
+}
+
+impl FilterEpoch {
+    /// The 18-state filter's view now: the covariances of its physical errors
+    /// ([`Seed18::physical_covariance`]), no scale factors.
+    pub fn of_seed18<E: EarthModel>(f: &Seed18<E>) -> Self {
+        let nav_cov = f.nav_covariance();
+        let [g, a] = f.sensor_std();
+        Self {
+            nav_cov,
+            nav_std: nav_cov.map(|p| p.diagonal().map(|v| v.max(0.0).sqrt())),
+            estimates: f.estimates(),
+            sensor_std: [g, a, Vector3::zeros(), Vector3::zeros()],
+        }
+    }
+}
+
+/// What a snapshot reads of a running filter: the psi-angle [`Integrator`] or the
+/// 18-state [`Seed18`].
+pub(crate) trait FilterView {
+    /// The state now.
+    fn view_state(&self) -> NavState;
+    /// The filter's view now.
+    fn view_epoch(&self) -> FilterEpoch;
+    /// Standard deviation of the barometer bias, when estimated.
+    fn view_baro_std(&self) -> Option<f64>;
+}
+
+impl<M: ErrorFrame, E: EarthModel> FilterView for Integrator<M, E> {
+    fn view_state(&self) -> NavState {
+        self.state()
+    }
+    fn view_epoch(&self) -> FilterEpoch {
+        FilterEpoch::of(self)
+    }
+    fn view_baro_std(&self) -> Option<f64> {
+        let p = self.covariance();
+        self.layout().baro_bias.map(|b| p[(b, b)].max(0.0).sqrt())
+    }
+}
+
+impl<E: EarthModel> FilterView for Seed18<E> {
+    fn view_state(&self) -> NavState {
+        self.state()
+    }
+    fn view_epoch(&self) -> FilterEpoch {
+        FilterEpoch::of_seed18(self)
+    }
+    fn view_baro_std(&self) -> Option<f64> {
+        None
     }
 }
 
@@ -219,26 +271,25 @@ impl SnapshotTaker {
 
     /// After a sample ending at `t` after `dt`: a snapshot at the first epoch of each
     /// period.
-    pub fn after_sample<M: ErrorFrame, E: EarthModel>(
+    pub fn after_sample<F: FilterView, E: EarthModel>(
         &mut self,
         earth: &E,
-        integ: &Integrator<M, E>,
+        integ: &F,
         t: f64,
         dt: f64,
     ) {
         if !self.cadence.take(t, dt) {
             return;
         }
-        let p = integ.covariance();
-        let l = integ.layout();
-        let state = integ.state();
+        let state = integ.view_state();
+        let f = integ.view_epoch();
         let nees = if self.truth.is_empty() {
             None
         } else {
             match self.truth_at(state.t) {
                 TruthAt::Exact(truth) | TruthAt::Interpolated(truth, _) => {
                     let e = errors_between(earth, &state, &(&truth).into());
-                    let [pp, pv, pa]: [Matrix3<f64>; 3] = integ.nav_covariance();
+                    let [pp, pv, pa]: [Matrix3<f64>; 3] = f.nav_cov;
                     Some([
                         normalized_squared(&e.pos_n, &pp),
                         normalized_squared(&e.v_n, &pv),
@@ -248,12 +299,11 @@ impl SnapshotTaker {
                 TruthAt::Before | TruthAt::After => None,
             }
         };
-        let f = FilterEpoch::of(integ);
         self.taken.push(Snapshot {
             t: state.t,
             estimates: f.estimates,
             sensor_std: f.sensor_std,
-            baro_std: l.baro_bias.map(|b| p[(b, b)].max(0.0).sqrt()),
+            baro_std: integ.view_baro_std(),
             nees,
         });
     }
