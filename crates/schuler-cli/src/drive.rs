@@ -608,23 +608,23 @@ mod tests {
     #[test]
     fn repeated_fields_are_the_vec_writers_text() {
         let dir = tempfile::tempdir().expect("temporary directory");
-        let rows: Vec<(f64, Vec<f64>)> = vec![
-            (1.0, vec![0.5, -2.25, 1e-9, 123.456]),
-            (1.005, vec![0.75, -2.25, 1e-9, 123.456]),
-            (1.01, vec![0.75, -2.25, 1e-9, 123.456]),
-            (1.015, vec![12345.678, 3.0, 1e-9, 123.456]),
-            (1.02, vec![f64::NAN, 3.0, 1e-9, 123.456]),
-            (1.025, vec![1.0, 3.0, 1e-9, 123.456]),
-            (1.03, vec![1.0, 3.0, 1e-9, 123.457]),
-            (1.035, vec![-0.0, 3.0, 1e-9, 123.457]),
-            (1.04, vec![2.0, 1e-9, 123.457]),
-            (1.045, vec![2.5, 1e-9, 123.457]),
+        let rows: [(f64, &[f64]); 10] = [
+            (1.0, &[0.5, -2.25, 1e-9, 123.456]),
+            (1.005, &[0.75, -2.25, 1e-9, 123.456]),
+            (1.01, &[0.75, -2.25, 1e-9, 123.456]),
+            (1.015, &[12345.678, 3.0, 1e-9, 123.456]),
+            (1.02, &[f64::NAN, 3.0, 1e-9, 123.456]),
+            (1.025, &[1.0, 3.0, 1e-9, 123.456]),
+            (1.03, &[1.0, 3.0, 1e-9, 123.457]),
+            (1.035, &[-0.0, 3.0, 1e-9, 123.457]),
+            (1.04, &[2.0, 1e-9, 123.457]),
+            (1.045, &[2.5, 1e-9, 123.457]),
         ];
         let mut table = Table::create(dir.path(), "t.txt").expect("create");
         let mut want = Vec::new();
-        for (t, values) in &rows {
-            table.row(*t, values).expect("row");
-            push_table_row(&mut want, *t, values);
+        for (t, values) in rows {
+            table.row(t, values).expect("row");
+            push_table_row(&mut want, t, values);
         }
         table.finish().expect("finish");
         let got = std::fs::read(dir.path().join("t.txt")).expect("read");
