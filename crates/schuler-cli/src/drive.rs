@@ -8,7 +8,7 @@
 
 use crate::aided::record::InnovationLog;
 use crate::bag::output::ResultBag;
-use crate::fixed::{Words, put_field};
+use crate::fixed::{Words, put_bytes, put_field};
 use crate::line_file::{LineFile, write_whole};
 use crate::output::{NavEpoch, NavWriter, push_fixed};
 use crate::text_block::{TextBlock, put_first_field};
@@ -29,6 +29,40 @@ pub struct Table {
     file: LineFile,
     text: TextBlock,
     line: Vec<u8>,
+    last: LastRow,
+}
+
+/// The last row written through the window: its values, and its text after the time
+/// (each field with its separator first, then the newline) with where each field
+/// starts. A row's last fields that equal the last row's (the same bits, so the same
+/// text) are copied from it rather than formatted again: the filter's estimates and
+/// sensor standard deviations change only at its updates and propagations, while
+/// KF-GINS's files have a row at every sample.
+#[derive(Default)]
+struct LastRow {
+    values: Vec<f64>,
+    text: Vec<u8>,
+    starts: Vec<usize>,
+}
+
+impl LastRow {
+    /// How many of the last values of `values` are those of the last row, bit for bit.
+    fn same_tail(&self, values: &[f64]) -> usize {
+        if values.len() != self.values.len() {
+            return 0;
+        }
+        values
+            .iter()
+            .rev()
+            .zip(self.values.iter().rev())
+            .take_while(|(a, b)| a.to_bits() == b.to_bits())
+            .count()
+    }
+
+    /// Forgets the last row (its line was made by the `Vec` writers).
+    fn clear(&mut self) {
+        self.values.clear();
+    }
 }
 
 /// A table line's window: the time and up to [`TABLE_FAST_VALUES`] values of at most
@@ -46,24 +80,55 @@ impl Table {
             file: LineFile::create(dir.join(name))?,
             text: TextBlock::default(),
             line: Vec::with_capacity(512),
+            last: LastRow::default(),
         })
     }
 
     /// One row: time, then the values (the bytes of [`push_table_row`]).
     pub fn row(&mut self, t: f64, values: &[f64]) -> Result<()> {
+        let same = self.last.same_tail(values);
+        let fresh = values.len() - same;
+        let before = self.text.len();
+        let last = &self.last;
+        // Where the time ends, and where each field starts after it.
+        let mut time_end = 0;
+        let mut starts = [0usize; TABLE_FAST_VALUES];
         let stored = values.len() <= TABLE_FAST_VALUES
             && self.text.put_line::<TABLE_WINDOW>(b' ', |w| {
                 let mut pos = put_first_field(w, 0, t, 6)?;
-                for v in values {
+                time_end = pos;
+                for (start, v) in starts.iter_mut().zip(&values[..fresh]) {
+                    *start = pos - time_end;
                     pos = put_field(w, pos, *v, 9)?;
                 }
-                w.put(pos, u64::from(b'\n'));
-                Some(pos + 1)
+                if same == 0 {
+                    w.put(pos, u64::from(b'\n'));
+                    return Some(pos + 1);
+                }
+                // The last row's fields from the first unchanged one, and its newline.
+                let (at, from) = (pos - time_end, last.starts[fresh]);
+                for (start, old) in starts[fresh..values.len()]
+                    .iter_mut()
+                    .zip(&last.starts[fresh..])
+                {
+                    *start = at + old - from;
+                }
+                Some(put_bytes(w, pos, &last.text[from..]))
             });
         if !stored {
+            self.last.clear();
             self.line.clear();
             push_table_row(&mut self.line, t, values);
             self.text.extend(&self.line);
+        } else if fresh > 0 {
+            let last = &mut self.last;
+            last.values.clear();
+            last.values.extend_from_slice(values);
+            last.starts.clear();
+            last.starts.extend_from_slice(&starts[..values.len()]);
+            last.text.clear();
+            last.text
+                .extend_from_slice(&self.text.as_bytes()[before + time_end..]);
         }
         if self.text.len() >= TABLE_BLOCK {
             self.flush()?;
@@ -97,30 +162,53 @@ pub fn push_table_row(line: &mut Vec<u8>, t: f64, values: &[f64]) {
 
 /// The KF-GINS IMU_ERR columns after time: gyro bias [deg/h], accelerometer bias
 /// [mGal], gyro and accelerometer scale factors [ppm].
-pub fn imu_err_row(e: &SensorEstimates) -> Vec<f64> {
-    let mut row = Vec::with_capacity(12);
-    row.extend(e.gyro_bias.iter().map(|x| x / DEG_PER_H));
-    row.extend(e.accel_bias.iter().map(|x| x / MGAL));
-    row.extend(e.gyro_scale.iter().map(|x| x / PPM));
-    row.extend(e.accel_scale.iter().map(|x| x / PPM));
-    row
+pub fn imu_err_row(e: &SensorEstimates) -> [f64; 12] {
+    let (gb, ab, gs, as_) = (e.gyro_bias, e.accel_bias, e.gyro_scale, e.accel_scale);
+    [
+        gb.x / DEG_PER_H,
+        gb.y / DEG_PER_H,
+        gb.z / DEG_PER_H,
+        ab.x / MGAL,
+        ab.y / MGAL,
+        ab.z / MGAL,
+        gs.x / PPM,
+        gs.y / PPM,
+        gs.z / PPM,
+        as_.x / PPM,
+        as_.y / PPM,
+        as_.z / PPM,
+    ]
 }
 
 /// The KF-GINS STD columns after time: position [m] and velocity [m/s] north, east,
 /// down, attitude roll, pitch, yaw [deg], gyro bias [deg/h], accelerometer bias [mGal],
 /// gyro and accelerometer scale factors [ppm].
-pub fn std_row(f: &FilterEpoch) -> Vec<f64> {
+pub fn std_row(f: &FilterEpoch) -> [f64; 21] {
     let [sp, sv, sa] = f.nav_std;
     let [gb, ab, gs, as_] = f.sensor_std;
-    let mut row = Vec::with_capacity(21);
-    row.extend_from_slice(sp.as_slice());
-    row.extend_from_slice(sv.as_slice());
-    row.extend(sa.iter().map(|x| x.to_degrees()));
-    row.extend(gb.iter().map(|x| x / DEG_PER_H));
-    row.extend(ab.iter().map(|x| x / MGAL));
-    row.extend(gs.iter().map(|x| x / PPM));
-    row.extend(as_.iter().map(|x| x / PPM));
-    row
+    [
+        sp.x,
+        sp.y,
+        sp.z,
+        sv.x,
+        sv.y,
+        sv.z,
+        sa.x.to_degrees(),
+        sa.y.to_degrees(),
+        sa.z.to_degrees(),
+        gb.x / DEG_PER_H,
+        gb.y / DEG_PER_H,
+        gb.z / DEG_PER_H,
+        ab.x / MGAL,
+        ab.y / MGAL,
+        ab.z / MGAL,
+        gs.x / PPM,
+        gs.y / PPM,
+        gs.z / PPM,
+        as_.x / PPM,
+        as_.y / PPM,
+        as_.z / PPM,
+    ]
 }
 
 /// A measurement the filter did not use, as `rejected.csv` lists it.
@@ -508,4 +596,41 @@ pub fn write_smoothed<E: EarthModel>(
     nav.finish()?;
     std.finish()?;
     err.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows whose last fields repeat the last row's (copied, not formatted), rows that
+    /// change everywhere, a row the window declines (NaN, then no copy from it) and a
+    /// row of another length: the file holds the text of [`push_table_row`] for each.
+    #[test]
+    fn repeated_fields_are_the_vec_writers_text() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let rows: [(f64, &[f64]); 10] = [
+            (1.0, &[0.5, -2.25, 1e-9, 123.456]),
+            (1.005, &[0.75, -2.25, 1e-9, 123.456]),
+            (1.01, &[0.75, -2.25, 1e-9, 123.456]),
+            (1.015, &[12345.678, 3.0, 1e-9, 123.456]),
+            (1.02, &[f64::NAN, 3.0, 1e-9, 123.456]),
+            (1.025, &[1.0, 3.0, 1e-9, 123.456]),
+            (1.03, &[1.0, 3.0, 1e-9, 123.457]),
+            (1.035, &[-0.0, 3.0, 1e-9, 123.457]),
+            (1.04, &[2.0, 1e-9, 123.457]),
+            (1.045, &[2.5, 1e-9, 123.457]),
+        ];
+        let mut table = Table::create(dir.path(), "t.txt").expect("create");
+        let mut want = Vec::new();
+        for (t, values) in rows {
+            table.row(t, values).expect("row");
+            push_table_row(&mut want, t, values);
+        }
+        table.finish().expect("finish");
+        let got = std::fs::read(dir.path().join("t.txt")).expect("read");
+        assert_eq!(
+            String::from_utf8_lossy(&got),
+            String::from_utf8_lossy(&want)
+        );
+    }
 }

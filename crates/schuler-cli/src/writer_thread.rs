@@ -6,7 +6,9 @@
 //! same order.
 //!
 //! Memory stays bounded: at most [`BATCHES`] batches of [`BATCH`] items wait in the
-//! channel; a full channel makes the navigation thread wait for the writer.
+//! channel; a full channel makes the navigation thread wait for the writer. The
+//! writer hands each emptied batch back, so that after the first few the batches are
+//! reused: no allocation per epoch or per batch, none freed on the other thread.
 
 use crate::drive::Outputs;
 use anyhow::{Result, anyhow};
@@ -20,20 +22,24 @@ pub const BATCH: usize = 256;
 /// Batches the channel holds.
 pub const BATCHES: usize = 2;
 
-/// What the navigation thread hands over, in order.
+/// What the navigation thread hands over, in order. Epochs are held in place (a
+/// batch is reused, so their size costs no allocation).
+#[allow(clippy::large_enum_variant)]
 enum Item {
     /// An output epoch.
-    Epoch(Box<Epoch>),
+    Epoch(Epoch),
     /// A session event.
     Event(Event),
     /// The state where a failed input stopped the run: written unless it was the
     /// last epoch written.
-    Last(Box<Epoch>),
+    Last(Epoch),
 }
 
 /// [`Outputs`] on a writer thread.
 pub struct WriterThread {
     tx: SyncSender<Vec<Item>>,
+    /// Emptied batches coming back from the writer.
+    spare: Receiver<Vec<Item>>,
     batch: Vec<Item>,
     handle: JoinHandle<Result<Outputs>>,
 }
@@ -42,11 +48,14 @@ impl WriterThread {
     /// Moves `out` onto a new writer thread.
     pub fn spawn(out: Outputs) -> Result<Self> {
         let (tx, rx) = sync_channel::<Vec<Item>>(BATCHES);
+        // Room for every batch there can be: sending one back never blocks.
+        let (spare_tx, spare) = sync_channel::<Vec<Item>>(BATCHES + 2);
         let handle = std::thread::Builder::new()
             .name("schuler-writer".to_owned())
-            .spawn(move || write_all(out, rx))?;
+            .spawn(move || write_all(out, rx, spare_tx))?;
         Ok(Self {
             tx,
+            spare,
             batch: Vec::with_capacity(BATCH),
             handle,
         })
@@ -55,7 +64,7 @@ impl WriterThread {
     /// Hands over the session's epochs and events so far.
     pub fn take<E: EarthModel>(&mut self, session: &mut Session<E>) -> Result<()> {
         for e in session.epochs() {
-            self.push(Item::Epoch(Box::new(e)))?;
+            self.push(Item::Epoch(e))?;
         }
         for e in session.events() {
             self.push(Item::Event(e))?;
@@ -66,7 +75,7 @@ impl WriterThread {
     /// Hands over the state where a failed input stopped the run (written unless it
     /// was the last epoch written).
     pub fn last(&mut self, e: Epoch) -> Result<()> {
-        self.push(Item::Last(Box::new(e)))
+        self.push(Item::Last(e))
     }
 
     fn push(&mut self, item: Item) -> Result<()> {
@@ -80,7 +89,11 @@ impl WriterThread {
     /// Sends the batch; a closed channel means the writer stopped on an error, which
     /// [`WriterThread::join`] returns.
     fn send(&mut self) -> Result<()> {
-        let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+        let next = self
+            .spare
+            .try_recv()
+            .unwrap_or_else(|_| Vec::with_capacity(BATCH));
+        let batch = std::mem::replace(&mut self.batch, next);
         if self.tx.send(batch).is_err() {
             return Err(anyhow!("the writer thread stopped"));
         }
@@ -107,16 +120,22 @@ impl WriterThread {
 }
 
 /// The writer thread: every batch from `rx` into `out`, until the channel closes or
-/// a write fails.
-fn write_all(mut out: Outputs, rx: Receiver<Vec<Item>>) -> Result<Outputs> {
-    for batch in rx {
-        for item in batch {
+/// a write fails; each emptied batch goes back through `spare` (dropped if the
+/// navigation thread is gone).
+fn write_all(
+    mut out: Outputs,
+    rx: Receiver<Vec<Item>>,
+    spare: SyncSender<Vec<Item>>,
+) -> Result<Outputs> {
+    for mut batch in rx {
+        for item in batch.drain(..) {
             match item {
                 Item::Epoch(e) => out.write_epoch(&e)?,
                 Item::Event(e) => out.event(e)?,
                 Item::Last(e) => out.write_last(&e)?,
             }
         }
+        let _ = spare.try_send(batch);
     }
     Ok(out)
 }
