@@ -604,6 +604,10 @@ impl Feed {
         {
             built = self.wait(built);
         }
+        // After a failure nobody takes knots any more: keep none.
+        if built.end.is_some() {
+            return;
+        }
         if built.first.is_none() {
             built.first = knots.first().map(|k| k.t);
         }
