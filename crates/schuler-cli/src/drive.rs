@@ -14,6 +14,7 @@ use crate::output::{NavEpoch, NavWriter, push_fixed};
 use crate::text_block::{TextBlock, put_first_field};
 use crate::writer_thread::WriterThread;
 use anyhow::Result;
+use nalgebra::Vector3;
 use schuler::earth::EarthModel;
 use schuler::filter::SensorEstimates;
 use schuler::filter::integration::SkipReason;
@@ -160,10 +161,9 @@ pub fn push_table_row(line: &mut Vec<u8>, t: f64, values: &[f64]) {
     line.push(b'\n');
 }
 
-/// The KF-GINS IMU_ERR columns after time: gyro bias [deg/h], accelerometer bias
-/// [mGal], gyro and accelerometer scale factors [ppm].
-pub fn imu_err_row(e: &SensorEstimates) -> [f64; 12] {
-    let (gb, ab, gs, as_) = (e.gyro_bias, e.accel_bias, e.gyro_scale, e.accel_scale);
+/// The sensor columns of KF-GINS's IMU_ERR and STD files: gyro bias [deg/h],
+/// accelerometer bias [mGal], gyro and accelerometer scale factors [ppm].
+fn sensor_columns([gb, ab, gs, as_]: [Vector3<f64>; 4]) -> [f64; 12] {
     [
         gb.x / DEG_PER_H,
         gb.y / DEG_PER_H,
@@ -180,13 +180,17 @@ pub fn imu_err_row(e: &SensorEstimates) -> [f64; 12] {
     ]
 }
 
+/// The KF-GINS IMU_ERR columns after time ([`sensor_columns`]).
+pub fn imu_err_row(e: &SensorEstimates) -> [f64; 12] {
+    sensor_columns([e.gyro_bias, e.accel_bias, e.gyro_scale, e.accel_scale])
+}
+
 /// The KF-GINS STD columns after time: position [m] and velocity [m/s] north, east,
-/// down, attitude roll, pitch, yaw [deg], gyro bias [deg/h], accelerometer bias [mGal],
-/// gyro and accelerometer scale factors [ppm].
+/// down, attitude roll, pitch, yaw [deg], then the [`sensor_columns`].
 pub fn std_row(f: &FilterEpoch) -> [f64; 21] {
     let [sp, sv, sa] = f.nav_std;
-    let [gb, ab, gs, as_] = f.sensor_std;
-    [
+    let mut row = [0.0; 21];
+    row[..9].copy_from_slice(&[
         sp.x,
         sp.y,
         sp.z,
@@ -196,19 +200,9 @@ pub fn std_row(f: &FilterEpoch) -> [f64; 21] {
         sa.x.to_degrees(),
         sa.y.to_degrees(),
         sa.z.to_degrees(),
-        gb.x / DEG_PER_H,
-        gb.y / DEG_PER_H,
-        gb.z / DEG_PER_H,
-        ab.x / MGAL,
-        ab.y / MGAL,
-        ab.z / MGAL,
-        gs.x / PPM,
-        gs.y / PPM,
-        gs.z / PPM,
-        as_.x / PPM,
-        as_.y / PPM,
-        as_.z / PPM,
-    ]
+    ]);
+    row[9..].copy_from_slice(&sensor_columns(f.sensor_std));
+    row
 }
 
 /// A measurement the filter did not use, as `rejected.csv` lists it.

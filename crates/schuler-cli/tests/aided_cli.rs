@@ -2,6 +2,7 @@
 //! (a tactical IMU at 200 Hz, GNSS at 1 Hz with a lever arm and a 60-s outage,
 //! a barometer with a 3-m bias): the barometer holds the height through the outage.
 
+use predicates::prelude::*;
 use std::path::Path;
 mod common;
 
@@ -44,4 +45,35 @@ fn a_barometer_holds_the_height_through_the_outage() {
     // The barometer's 0.5 m noise, averaged by the filter, with its bias estimated
     // under GNSS beforehand.
     assert!(with < 1.0, "{with}");
+}
+
+/// `--error-model` beside `--scale-factors`: without the new flag `--scale-factors`
+/// is the 21-state filter as it always was, the same bytes as `--error-model psi21`
+/// (the Python suite's scale-factor run found it refused after the flag came in);
+/// `psi15` with `--scale-factors` contradicts itself and is refused naming both.
+#[test]
+fn scale_factors_are_psi21_and_psi15_refuses_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sim = common::simulate_drive(dir.path());
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let extra: Vec<&std::ffi::OsStr> = extra.iter().map(|s| s.as_ref()).collect();
+        (common::nav_drive(&sim, &out, &extra), out)
+    };
+    let (flag, by_flag) = run("flag", &["--scale-factors", "--no-report"]);
+    flag.success();
+    let (model, by_model) = run("model", &["--error-model", "psi21", "--no-report"]);
+    model.success();
+    for file in ["nav.txt", "std.txt", "imu_err.txt"] {
+        let read = |d: &Path| std::fs::read(d.join(file)).expect("output");
+        assert!(read(&by_flag) == read(&by_model), "{file} differs");
+    }
+    let (both, _) = run(
+        "both",
+        &["--error-model", "psi15", "--scale-factors", "--no-report"],
+    );
+    both.failure().stderr(
+        predicates::str::contains("--error-model psi15")
+            .and(predicates::str::contains("--scale-factors")),
+    );
 }

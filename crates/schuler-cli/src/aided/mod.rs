@@ -165,7 +165,7 @@ pub struct AidingOptions {
     #[arg(long)]
     #[serde(default)]
     pub scale_factors: bool,
-    /// The filter's error model: psi15 (default), psi21 (as --scale-factors) or
+    /// The filter's error model: psi15 (default; psi21 with --scale-factors), psi21 or
     /// seed18, the flight-test paper's 18 states (needs --mechanization wander; GNSS
     /// position and velocity only, no lever arm, no smoother).
     #[arg(long, value_name = "MODEL")]
@@ -728,16 +728,18 @@ impl AidingOptions {
     /// states on in `integration`).
     fn error_model(&self, integration: &mut IntegrationConfig) -> Result<ErrorModelChoice> {
         use crate::options::ErrorModelArg;
-        Ok(match self.error_model.unwrap_or_default() {
-            ErrorModelArg::Psi15 if self.scale_factors => {
+        // Without the flag: psi15, or psi21 with --scale-factors, as before the flag.
+        Ok(match self.error_model {
+            None => ErrorModelChoice::Psi,
+            Some(ErrorModelArg::Psi15) if self.scale_factors => {
                 bail!("--error-model psi15 has no scale factors; --scale-factors is psi21")
             }
-            ErrorModelArg::Psi15 => ErrorModelChoice::Psi,
-            ErrorModelArg::Psi21 => {
+            Some(ErrorModelArg::Psi15) => ErrorModelChoice::Psi,
+            Some(ErrorModelArg::Psi21) => {
                 integration.scale_factors = true;
                 ErrorModelChoice::Psi
             }
-            ErrorModelArg::Seed18 => ErrorModelChoice::Seed18,
+            Some(ErrorModelArg::Seed18) => ErrorModelChoice::Seed18,
         })
     }
 
