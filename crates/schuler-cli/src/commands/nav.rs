@@ -435,7 +435,8 @@ where
     let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
         bail!("--init {init:?} needs GNSS fixes (--gnss FILE)");
     };
-    let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &aiding.fixes);
+    let all = aiding.fixes.to_vec()?;
+    let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &all);
     let context = || format!("--init gnss: {}", settings.imu.display());
     let first = match reader.next() {
         Some(s) => s?,
