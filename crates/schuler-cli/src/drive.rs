@@ -6,7 +6,9 @@
 //! reason). On a read error everything computed so far is written before the error is
 //! returned.
 
+use crate::aided::feed::AidFeed;
 use crate::aided::record::InnovationLog;
+use crate::aided::spilled::Spilled;
 use crate::bag::output::ResultBag;
 use crate::fixed::{Words, put_bytes, put_field};
 use crate::line_file::{LineFile, write_whole};
@@ -20,7 +22,7 @@ use schuler::filter::SensorEstimates;
 use schuler::filter::integration::SkipReason;
 use schuler::filter::smoother::SmoothedTrajectory;
 use schuler::imu::ImuSample;
-use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session};
+use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session, Snapshot};
 use schuler::units::{DEG_PER_H, MGAL, PPM};
 use std::path::Path;
 
@@ -455,6 +457,8 @@ pub struct Driven {
     /// The first output epoch whose heading standard deviation was below 1°: its time
     /// [s] and heading [rad].
     pub heading_settled: Option<(f64, f64)>,
+    /// The filter's snapshots, taken from the session as the run goes (bounded memory).
+    pub snapshots: Spilled<Snapshot>,
 }
 
 /// Closes the trajectory files and the result bag; the number of epochs written.
@@ -474,13 +478,16 @@ fn writer_error(pipe: WriterThread) -> anyhow::Error {
     }
 }
 
-/// Pushes `samples` into `session`, writing what comes out to `out` on a writer
-/// thread ([`WriterThread`]); `on_sample` is called every 65,536 samples with their
+/// Pushes `samples` into `session`, each after the aids `feed` has due before it
+/// ([`AidFeed`]), writing what comes out to `out` on a writer thread
+/// ([`WriterThread`]) and keeping the filter's snapshots as they come (in
+/// [`Driven::snapshots`]); `on_sample` is called every 65,536 samples with their
 /// count. On a read error the session ends there, its last state is written (if it
 /// was not an output epoch) and the error is returned in [`Driven::failure`] with the
 /// count and the time reached. `None` when the input held no sample at all.
 pub fn drive<M: EarthModel, I, E>(
     mut session: Session<M>,
+    mut feed: AidFeed<'_>,
     samples: I,
     out: Outputs,
     dir: &Path,
@@ -493,6 +500,7 @@ where
     let mut pipe = WriterThread::spawn(out)?;
     let mut n = 0u64;
     let mut failure: Option<anyhow::Error> = None;
+    let mut snapshots = Spilled::default();
     for s in samples {
         // A signal stops the run here, as a read error does: everything before is
         // written, every file ends on a whole line.
@@ -500,9 +508,10 @@ where
             failure = Some(i.into());
             break;
         }
-        let pushed = s
-            .map_err(anyhow::Error::new)
-            .and_then(|s| session.push_imu(s).map_err(anyhow::Error::new));
+        let pushed = s.map_err(anyhow::Error::new).and_then(|s| {
+            feed.before(&mut session, &s)?;
+            session.push_imu(s).map_err(anyhow::Error::new)
+        });
         if let Err(e) = pushed {
             failure = Some(e);
             break;
@@ -513,7 +522,11 @@ where
         n += 1;
         if n.is_multiple_of(65_536) {
             on_sample(n);
+            session.snapshots().for_each(|x| snapshots.push(&x));
         }
+    }
+    if let Err(e) = feed.rest(&mut session) {
+        failure.get_or_insert(e);
     }
     session.end_of_input();
     if pipe.take(&mut session).is_err() {
@@ -531,6 +544,7 @@ where
         return Err(writer_error(pipe));
     }
     let out = pipe.join()?;
+    session.snapshots().for_each(|x| snapshots.push(&x));
     let finished = match session.finish() {
         Ok(f) => f,
         Err(e) => {
@@ -546,6 +560,11 @@ where
             )));
         }
     };
+    let mut finished = finished;
+    finished
+        .snapshots
+        .drain(..)
+        .for_each(|x| snapshots.push(&x));
     let epochs = close_trajectory(out.nav, out.bag)?;
     let failure = failure.map(|e| {
         e.context(format!(
@@ -560,6 +579,7 @@ where
         failure,
         epochs,
         heading_settled: out.heading_settled,
+        snapshots,
         filter: out.filter,
     }))
 }

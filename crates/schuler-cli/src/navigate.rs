@@ -3,7 +3,9 @@
 //! its output written by [`crate::drive`]. With aiding the run also writes
 //! `rejected.csv`, the smoothed trajectory on request and the consistency report.
 
+use crate::aided::feed::AidFeed;
 use crate::aided::report::{ReportData, RunFacts};
+use crate::aided::spilled::Spilled;
 use crate::aided::{Aiding, OutputNames};
 use crate::drive::{Driven, FilterFiles, Outputs, drive, write_smoothed};
 use crate::formats::ImuReadOptions;
@@ -12,13 +14,13 @@ use crate::output::NavWriter;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Geodetic};
-use schuler::filter::{GnssFix, Layout};
+use schuler::filter::Layout;
 use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
 use schuler::session::{
     Aid, Chosen, Finished, HeadingBank, MechanizationConfig, Session, SessionConfig, SessionError,
-    Start, Summary,
+    Snapshot, Start, Summary,
 };
 use std::path::{Path, PathBuf};
 
@@ -95,6 +97,22 @@ pub struct RunSummary {
     pub heading_settled: Option<(f64, f64)>,
 }
 
+/// The session from `start` with the settings' configuration (aided: with the
+/// truth); configuration errors name the flag.
+fn new_session<E: EarthModel>(
+    earth: E,
+    settings: &NavSettings,
+    aiding: Option<&Aiding>,
+    start: Start,
+) -> Result<Session<E>> {
+    let mut session =
+        Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
+    if let Some(rows) = aiding.and_then(|a| a.report.truth.as_ref()?.held.clone()) {
+        session = session.with_truth(rows);
+    }
+    Ok(session)
+}
+
 /// The session from `start` with the settings' configuration (aided: with the truth
 /// and every aid pushed); configuration errors name the flag.
 pub fn open_session<E: EarthModel>(
@@ -103,10 +121,11 @@ pub fn open_session<E: EarthModel>(
     aiding: Option<&Aiding>,
     start: Start,
 ) -> Result<Session<E>> {
-    let mut session =
-        Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
+    let mut session = new_session(earth, settings, aiding, start)?;
     if let Some(a) = aiding {
-        session = session.with_truth(a.report.truth_rows().to_vec());
+        if a.report.truth.as_ref().is_some_and(|t| t.held.is_none()) {
+            session = session.with_truth(a.report.truth_records()?);
+        }
         for aid in aids(a) {
             session.push(aid)?;
         }
@@ -114,16 +133,21 @@ pub fn open_session<E: EarthModel>(
     Ok(session)
 }
 
-/// [`open_session`] and the outputs it writes into `settings.out`: the navigation
-/// result and, aided, the filter's files.
-fn open<E: EarthModel>(
+/// The session (its aids to be fed in step with the samples, [`AidFeed`]) and the
+/// outputs it writes into `settings.out`: the navigation result and, aided, the
+/// filter's files.
+fn open<'a, E: EarthModel>(
     earth: E,
     settings: &NavSettings,
-    aiding: Option<&Aiding>,
+    aiding: Option<&'a Aiding>,
     start: Start,
-) -> Result<(Session<E>, Outputs)> {
-    let session = open_session(earth, settings, aiding, start)?;
-    Ok((session, outputs(&earth, settings, aiding)?))
+) -> Result<(Session<E>, AidFeed<'a>, Outputs)> {
+    let mut session = new_session(earth, settings, aiding, start)?;
+    let feed = match aiding {
+        Some(a) => AidFeed::open(a, &mut session)?,
+        None => AidFeed::none(),
+    };
+    Ok((session, feed, outputs(&earth, settings, aiding)?))
 }
 
 /// The outputs a run writes into `settings.out`: the navigation result and, aided,
@@ -185,6 +209,7 @@ fn finish_aided<E: EarthModel>(
     a: &Aiding,
     files: FilterFiles,
     finished: &mut Finished,
+    snapshots: &Spilled<Snapshot>,
     failure: Option<anyhow::Error>,
 ) -> Result<String> {
     let out = &settings.out;
@@ -205,7 +230,7 @@ fn finish_aided<E: EarthModel>(
         &ReportData {
             facts: run_facts(settings, a, &nav_file, &finished.summary),
             innovations: &log.rows,
-            samples: &finished.snapshots,
+            samples: snapshots,
             settings: &a.report,
         },
     )
@@ -226,8 +251,8 @@ where
     I: Iterator<Item = Result<ImuSample, Fail>>,
     Fail: std::error::Error + Send + Sync + 'static,
 {
-    let (session, outputs) = open(earth, settings, aiding, start)?;
-    let driven = drive(session, samples, outputs, &settings.out, on_sample)?;
+    let (session, feed, outputs) = open(earth, settings, aiding, start)?;
+    let driven = drive(session, feed, samples, outputs, &settings.out, on_sample)?;
     conclude(&earth, settings, aiding, driven)
 }
 
@@ -251,9 +276,18 @@ fn conclude<E: EarthModel>(
         epochs,
         filter,
         heading_settled,
+        snapshots,
     } = driven;
     let report_text = match (aiding, filter) {
-        (Some(a), Some(files)) => finish_aided(earth, settings, a, files, &mut finished, failure)?,
+        (Some(a), Some(files)) => finish_aided(
+            earth,
+            settings,
+            a,
+            files,
+            &mut finished,
+            &snapshots,
+            failure,
+        )?,
         _ => match failure {
             Some(e) => return Err(e),
             None => String::new(),
@@ -283,6 +317,7 @@ fn check_clocks(settings: &NavSettings, a: &Aiding, s: &Summary) -> Result<()> {
         .iter()
         .filter(|f| f.t >= s.t_first && f.t <= s.t_last)
         .count();
+    a.fixes.status()?;
     let spans = format!(
         "the IMU samples span t = {} .. {} s ({}), the GNSS fixes t = {} .. {} s",
         s.t_first,
@@ -345,7 +380,14 @@ where
     for e in chosen.events {
         out.event(e)?;
     }
-    let driven = drive(chosen.session, samples, out, &settings.out, on_sample)?;
+    let driven = drive(
+        chosen.session,
+        AidFeed::none(),
+        samples,
+        out,
+        &settings.out,
+        on_sample,
+    )?;
     let summary = conclude(&earth, settings, Some(aiding), driven)?;
     Ok((summary, chosen.yaw0, decided))
 }
@@ -368,7 +410,7 @@ where
     let config = settings.session_config(Some(aiding));
     let mut bank = HeadingBank::new(earth, config, start, members)
         .map_err(named_flag)?
-        .with_truth(aiding.report.truth_rows());
+        .with_truth(&aiding.report.truth_records()?);
     for aid in aids(aiding) {
         bank.push(aid)?;
     }
@@ -397,7 +439,7 @@ pub const BANK_MARGIN: f64 = 20.0;
 
 /// Every aid of a run, as pushed: GNSS fixes, barometer readings, vehicle readings.
 fn aids(a: &Aiding) -> impl Iterator<Item = Aid> + '_ {
-    let fixes = a.fixes.iter().map(|f: &GnssFix| Aid::Gnss(*f));
+    let fixes = a.fixes.iter().map(Aid::Gnss);
     let baro = a.baro.iter().map(|&(t, h)| Aid::Baro { t, h });
     fixes.chain(baro).chain(a.vehicle.aids())
 }

@@ -4,8 +4,12 @@
 //! aids. [`report`] writes the consistency report, [`record`] `innovations.csv`,
 //! [`vehicle`] resolves the vehicle aids.
 
+pub mod feed;
+pub mod fixes;
 pub mod record;
 pub mod report;
+pub mod series;
+pub mod spilled;
 pub mod vehicle;
 
 use crate::formats::gnss::{GnssFormat, GnssQuality, GnssReadOptions, read_gnss_log};
@@ -66,8 +70,8 @@ type BaroInput = (Vec<(f64, f64)>, Option<(f64, f64)>);
 /// What aiding a run has: the filter and the readings pushed as aids.
 #[derive(Debug, Clone)]
 pub struct Aiding {
-    /// GNSS fixes in time order.
-    pub fixes: Vec<GnssFix>,
+    /// GNSS fixes in time order (spilled: bounded memory).
+    pub fixes: fixes::Fixes,
     /// The session's filter (noise, prior, gate, barometer, smoother, vehicle aids).
     pub filter: FilterConfig,
     /// Output file names.
@@ -502,7 +506,7 @@ impl AidingOptions {
             outage_test,
             baro,
             report: self.report()?,
-            fixes,
+            fixes: fixes.into(),
         }))
     }
 
@@ -789,10 +793,7 @@ impl AidingOptions {
     fn report(&self) -> Result<ReportSettings> {
         Ok(ReportSettings {
             html: !self.no_report,
-            truth: match &self.truth {
-                Some(p) => Some((p.clone(), crate::formats::nav::read_nav(p)?.1)),
-                None => None,
-            },
+            truth: self.truth.as_deref().map(report::Truth::file).transpose()?,
             sensor_truth: match &self.sensor_truth {
                 Some(p) => crate::formats::sensor_errors::read_sensor_errors(p)?,
                 None => Vec::new(),

@@ -14,9 +14,14 @@
 //! The report also takes the session's once-a-second [`ReportSample`]s: the estimated
 //! sensor errors with their standard deviations and, against a truth, the normalized
 //! estimation errors squared (NEES) of position, velocity and attitude.
+//!
+//! Both are kept as [`Spilled`] records (bounded memory, the rest on disk), so that
+//! the report of a long run costs no more memory than a short one's.
 
+use super::spilled::{Record, Spilled};
 use crate::line_file::LineWriter;
 use anyhow::{Result, bail};
+use nalgebra::Vector3;
 use schuler::filter::integration::Innovation;
 use schuler::filter::measurement::Kind;
 use std::io::Write;
@@ -75,13 +80,72 @@ impl InnovationRow {
     }
 }
 
-/// Streams `innovations.csv` and keeps the rows for the report.
+/// The measurement kinds in the order of their code in a stored [`InnovationRow`].
+const KINDS: [Kind; 8] = [
+    Kind::GnssPosition,
+    Kind::GnssVelocity,
+    Kind::BaroHeight,
+    Kind::ZeroVelocity,
+    Kind::ZeroRate,
+    Kind::NonHolonomic,
+    Kind::Odometer,
+    Kind::Heading,
+];
+
+/// The code of `kind` in [`KINDS`].
+fn kind_code(kind: Kind) -> usize {
+    match kind {
+        Kind::GnssPosition => 0,
+        Kind::GnssVelocity => 1,
+        Kind::BaroHeight => 2,
+        Kind::ZeroVelocity => 3,
+        Kind::ZeroRate => 4,
+        Kind::NonHolonomic => 5,
+        Kind::Odometer => 6,
+        Kind::Heading => 7,
+    }
+}
+
+impl Record for InnovationRow {
+    /// `t, kind code, accepted, dof, nis, z (3), sigma (3)`.
+    const WIDTH: usize = 5 + 2 * MAX_COMPONENTS;
+
+    fn encode(&self, out: &mut [f64]) {
+        out[..5].copy_from_slice(&[
+            self.t,
+            kind_code(self.kind) as f64,
+            f64::from(u8::from(self.accepted)),
+            self.dof as f64,
+            self.nis,
+        ]);
+        out[5..5 + MAX_COMPONENTS].copy_from_slice(&self.z);
+        out[5 + MAX_COMPONENTS..].copy_from_slice(&self.sigma);
+    }
+
+    fn decode(r: &[f64]) -> Self {
+        let mut row = InnovationRow {
+            t: r[0],
+            // The codes are written by `encode` from `KINDS`: always in range.
+            kind: KINDS[(r[1] as usize).min(KINDS.len() - 1)],
+            accepted: r[2] != 0.0,
+            dof: r[3] as usize,
+            nis: r[4],
+            z: [0.0; MAX_COMPONENTS],
+            sigma: [0.0; MAX_COMPONENTS],
+        };
+        row.z.copy_from_slice(&r[5..5 + MAX_COMPONENTS]);
+        row.sigma.copy_from_slice(&r[5 + MAX_COMPONENTS..]);
+        row
+    }
+}
+
+/// Streams `innovations.csv` and keeps the rows for the report (spilled).
 #[derive(Debug)]
 pub struct InnovationLog {
     w: LineWriter,
     line: String,
     /// Every row written, in time order.
-    pub rows: Vec<InnovationRow>,
+    pub rows: Spilled<InnovationRow>,
 }
 
 impl InnovationLog {
@@ -92,7 +156,7 @@ impl InnovationLog {
         Ok(Self {
             w,
             line: String::with_capacity(256),
-            rows: Vec::new(),
+            rows: Spilled::default(),
         })
     }
 
@@ -124,7 +188,7 @@ impl InnovationLog {
         }
         self.line.push('\n');
         self.w.write_all(self.line.as_bytes())?;
-        self.rows.push(r);
+        self.rows.push(&r);
         Ok(())
     }
 
@@ -138,6 +202,63 @@ impl InnovationLog {
 /// The filter's view of the sensor errors and, against a truth, its NEES, at one
 /// instant (the session's snapshot, taken once a second).
 pub use schuler::session::Snapshot as ReportSample;
+
+/// A value and whether it is there (`None` stored as flag 0 and value 0).
+fn opt_in(x: Option<f64>) -> [f64; 2] {
+    x.map_or([0.0, 0.0], |x| [1.0, x])
+}
+
+/// The option [`opt_in`] stored.
+fn opt_out(r: &[f64]) -> Option<f64> {
+    (r[0] != 0.0).then_some(r[1])
+}
+
+impl Record for ReportSample {
+    /// `t`, the 17 sensor estimates, the 12 sensor standard deviations, the barometer
+    /// bias's (flag, value), whether there is a NEES, then each NEES's (flag, value).
+    const WIDTH: usize = 1 + 17 + 12 + 2 + 1 + 6;
+
+    fn encode(&self, out: &mut [f64]) {
+        let e = &self.estimates;
+        out[0] = self.t;
+        let blocks = [e.gyro_bias, e.accel_bias, e.gyro_scale, e.accel_scale];
+        for (k, v) in blocks.iter().chain(&self.sensor_std).enumerate() {
+            let o = if k < 4 { 1 + 3 * k } else { 18 + 3 * (k - 4) };
+            out[o..o + 3].copy_from_slice(v.as_slice());
+        }
+        out[13..18].copy_from_slice(&[
+            e.baro_bias,
+            e.odometer_scale,
+            e.mounting.x,
+            e.mounting.y,
+            e.mounting.z,
+        ]);
+        out[30..32].copy_from_slice(&opt_in(self.baro_std));
+        out[32] = f64::from(u8::from(self.nees.is_some()));
+        for (k, n) in self.nees.unwrap_or([None; 3]).iter().enumerate() {
+            out[33 + 2 * k..35 + 2 * k].copy_from_slice(&opt_in(*n));
+        }
+    }
+
+    fn decode(r: &[f64]) -> Self {
+        let v = |o: usize| Vector3::new(r[o], r[o + 1], r[o + 2]);
+        ReportSample {
+            t: r[0],
+            estimates: schuler::filter::SensorEstimates {
+                gyro_bias: v(1),
+                accel_bias: v(4),
+                gyro_scale: v(7),
+                accel_scale: v(10),
+                baro_bias: r[13],
+                odometer_scale: r[14],
+                mounting: v(15),
+            },
+            sensor_std: [v(18), v(21), v(24), v(27)],
+            baro_std: opt_out(&r[30..32]),
+            nees: (r[32] != 0.0).then(|| std::array::from_fn(|k| opt_out(&r[33 + 2 * k..]))),
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -22,6 +22,8 @@
 //! (`tests/gnss_integration.rs`) is the sharp one.
 
 use super::record::{InnovationRow, ReportSample};
+use super::series::{Series, series};
+use super::spilled::Spilled;
 use crate::plot::{LineStyle, Plot};
 use crate::report::{Report, Table};
 use anyhow::{Context, Result};
@@ -46,9 +48,8 @@ pub const PROBABILITY: f64 = 0.95;
 pub struct ReportSettings {
     /// Write `report.html` and `report/`.
     pub html: bool,
-    /// Navigation truth (KF-GINS text or nav.csv), for errors and NEES: its path and
-    /// epochs in time order.
-    pub truth: Option<(PathBuf, Vec<NavRecord>)>,
+    /// Navigation truth (KF-GINS text or nav.csv), for errors and NEES.
+    pub truth: Option<Truth>,
     /// Sensor-error truth (`imu_err.txt`'s layout), in time order; empty: none.
     pub sensor_truth: Vec<(f64, SensorEstimates)>,
 }
@@ -64,9 +65,39 @@ impl Default for ReportSettings {
 }
 
 impl ReportSettings {
-    /// The truth's epochs (empty without one).
-    pub fn truth_rows(&self) -> &[NavRecord] {
-        self.truth.as_ref().map_or(&[], |t| &t.1)
+    /// The truth's epochs (empty without one), read whole.
+    pub fn truth_records(&self) -> Result<Vec<NavRecord>> {
+        self.truth.as_ref().map_or(Ok(Vec::new()), Truth::records)
+    }
+}
+
+/// The navigation truth of `--truth`, or one held in memory (a campaign's simulated
+/// truth).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Truth {
+    /// Its file, as the report names it.
+    pub path: PathBuf,
+    /// Its epochs in time order when held in memory; `None`: read from `path` (checked
+    /// whole when the options were loaded) as the run goes, an epoch at a time.
+    pub held: Option<Vec<NavRecord>>,
+}
+
+impl Truth {
+    /// A truth file, read as the run goes (checked through now).
+    pub fn file(path: &Path) -> Result<Self> {
+        crate::formats::nav::check_nav(path)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            held: None,
+        })
+    }
+
+    /// Every epoch (the file read whole).
+    pub fn records(&self) -> Result<Vec<NavRecord>> {
+        match &self.held {
+            Some(rows) => Ok(rows.clone()),
+            None => Ok(crate::formats::nav::read_nav(&self.path)?.1),
+        }
     }
 }
 
@@ -92,7 +123,7 @@ pub struct RunFacts<'a> {
     /// Times the gate was bypassed after consecutive refusals.
     pub gate_resets: usize,
     /// The GNSS fixes used (after any test outages were cut out).
-    pub fixes: &'a [GnssFix],
+    pub fixes: &'a super::fixes::Fixes,
 }
 
 /// The NIS test of one measurement kind.
@@ -110,10 +141,14 @@ pub struct KindConsistency {
     pub test: Option<ChiSquareTest>,
 }
 
-/// NIS per kind, in order of first appearance.
-pub fn nis_by_kind(rows: &[InnovationRow]) -> Vec<KindConsistency> {
+/// NIS per kind, in order of first appearance, over the rows `rows()` yields (read
+/// once per kind).
+pub fn nis_by_kind<I>(rows: impl Fn() -> I) -> Vec<KindConsistency>
+where
+    I: Iterator<Item = InnovationRow>,
+{
     let mut kinds: Vec<(Kind, usize)> = Vec::new();
-    for r in rows {
+    for r in rows() {
         if !kinds.iter().any(|k| k.0 == r.kind) {
             kinds.push((r.kind, r.dof));
         }
@@ -121,7 +156,7 @@ pub fn nis_by_kind(rows: &[InnovationRow]) -> Vec<KindConsistency> {
     kinds
         .into_iter()
         .map(|(kind, dof)| {
-            let of_kind = || rows.iter().filter(move |r| r.kind == kind);
+            let of_kind = || rows().filter(move |r| r.kind == kind);
             let accepted = of_kind().filter(|r| r.accepted).count();
             KindConsistency {
                 kind,
@@ -141,13 +176,15 @@ pub fn nis_by_kind(rows: &[InnovationRow]) -> Vec<KindConsistency> {
 /// Names of the NEES blocks, in [`ReportSample::nees`] order.
 pub const NEES_BLOCKS: [&str; 3] = ["position", "velocity", "attitude"];
 
-/// NEES tests of position, velocity and attitude over the samples that have one.
-pub fn nees_tests(samples: &[ReportSample]) -> [Option<ChiSquareTest>; 3] {
+/// NEES tests of position, velocity and attitude over the samples `samples()` yields
+/// that have one.
+pub fn nees_tests<I>(samples: impl Fn() -> I) -> [Option<ChiSquareTest>; 3]
+where
+    I: Iterator<Item = ReportSample>,
+{
     std::array::from_fn(|k| {
         ChiSquareTest::of(
-            samples
-                .iter()
-                .filter_map(|s| s.nees.map(|n| n[k].unwrap_or(f64::INFINITY))),
+            samples().filter_map(|s| s.nees.map(|n| n[k].unwrap_or(f64::INFINITY))),
             3,
             PROBABILITY,
         )
@@ -265,28 +302,10 @@ pub fn gnss_gaps(fixes: &[GnssFix]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// `(t, y)` with a NaN point inserted before each step in `t` longer than twice the
-/// median step, so that a plotted line breaks across data gaps instead of bridging
-/// them.
-fn gapped(t: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    dt.sort_unstable_by(f64::total_cmp);
-    let limit = dt.get(dt.len() / 2).map_or(f64::INFINITY, |m| 2.0 * m);
-    let mut out = (Vec::with_capacity(t.len()), Vec::with_capacity(y.len()));
-    for (k, (&ti, &yi)) in t.iter().zip(y).enumerate() {
-        if k > 0 && ti - t[k - 1] > limit {
-            out.0.push(f64::NAN);
-            out.1.push(f64::NAN);
-        }
-        out.0.push(ti);
-        out.1.push(yi);
-    }
-    out
-}
-
 /// A series plus its ±`k`·σ envelope about `center` (a zero `center`: about zero),
 /// as two lines: the series, and the envelope drawn as one series (upper, a break,
-/// lower) so both bounds share a colour and a legend entry; lines break at gaps.
+/// lower) so both bounds share a colour and a legend entry; `t` and the values carry
+/// the gaps' NaN points ([`series`]), where the lines break.
 fn with_envelope(
     plot: Plot,
     (name, band): (&str, &str),
@@ -295,18 +314,14 @@ fn with_envelope(
     center: &[f64],
     sigma3: &[f64],
 ) -> Plot {
-    let (x, y) = gapped(t, y);
-    let up: Vec<f64> = center.iter().zip(sigma3).map(|(c, s)| c + s).collect();
-    let down: Vec<f64> = center.iter().zip(sigma3).map(|(c, s)| c - s).collect();
-    let (xu, mut yu) = gapped(t, &up);
-    let (xd, yd) = gapped(t, &down);
-    let mut xb = xu;
+    let mut yb: Vec<f64> = center.iter().zip(sigma3).map(|(c, s)| c + s).collect();
+    yb.push(f64::NAN);
+    yb.extend(center.iter().zip(sigma3).map(|(c, s)| c - s));
+    let mut xb = t.to_vec();
     xb.push(f64::NAN);
-    xb.extend(xd);
-    yu.push(f64::NAN);
-    yu.extend(yd);
-    plot.line(name, &x, &y, LineStyle::Solid)
-        .line(band, &xb, &yu, LineStyle::Dashed)
+    xb.extend_from_slice(t);
+    plot.line(name, t, y, LineStyle::Solid)
+        .line(band, &xb, &yb, LineStyle::Dashed)
 }
 
 /// What every section needs: where plots and CSVs go (`OUT/report/`), the run's
@@ -344,7 +359,7 @@ impl Ctx<'_> {
     }
 
     /// A CSV with a header and one row per item, numbers shortest round-trip, `None`
-    /// empty.
+    /// empty; streamed, and removed if it cannot be written whole.
     fn csv(
         &self,
         name: &str,
@@ -352,23 +367,40 @@ impl Ctx<'_> {
         rows: impl Iterator<Item = Vec<Option<f64>>>,
     ) -> Result<String> {
         let path = self.dir.join(name);
-        let mut s = String::with_capacity(1 << 16);
-        s.push_str(header);
-        s.push('\n');
-        for row in rows {
-            for (k, v) in row.iter().enumerate() {
-                if k > 0 {
-                    s.push(',');
-                }
-                if let Some(v) = v {
-                    let _ = write!(s, "{v}");
-                }
-            }
-            s.push('\n');
+        let written = write_csv(&path, header, rows);
+        if written.is_err() {
+            let _ = std::fs::remove_file(&path);
         }
-        crate::line_file::write_whole(&path, s)?;
+        written?;
         Ok(format!("report/{name}"))
     }
+}
+
+/// Writes `path`: `header`, then each row, numbers shortest round-trip, `None` empty.
+fn write_csv(
+    path: &Path,
+    header: &str,
+    rows: impl Iterator<Item = Vec<Option<f64>>>,
+) -> Result<()> {
+    use std::io::Write as _;
+    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut s = String::with_capacity(1 << 10);
+    writeln!(w, "{header}").with_context(|| format!("cannot write {}", path.display()))?;
+    for row in rows {
+        s.clear();
+        for (k, v) in row.iter().enumerate() {
+            if k > 0 {
+                s.push(',');
+            }
+            if let Some(v) = v {
+                let _ = write!(s, "{v}");
+            }
+        }
+        s.push('\n');
+        w.write_all(s.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    w.finish()
 }
 
 /// Everything the report is built from.
@@ -376,9 +408,9 @@ pub struct ReportData<'a> {
     /// The run.
     pub facts: RunFacts<'a>,
     /// Every tested measurement.
-    pub innovations: &'a [InnovationRow],
+    pub innovations: &'a Spilled<InnovationRow>,
     /// The filter's snapshots, once a second.
-    pub samples: &'a [ReportSample],
+    pub samples: &'a Spilled<ReportSample>,
     /// The truths.
     pub settings: &'a ReportSettings,
 }
@@ -386,9 +418,12 @@ pub struct ReportData<'a> {
 /// Writes `consistency.json` and, if `html`, `report.html` with `report/`; returns
 /// the text to print.
 pub fn write(out: &Path, html: bool, data: &ReportData) -> Result<String> {
-    let nis = nis_by_kind(data.innovations);
+    let nis = nis_by_kind(|| data.innovations.iter());
     let has_truth = data.settings.truth.is_some();
-    let nees = has_truth.then(|| nees_tests(data.samples));
+    let nees = has_truth.then(|| nees_tests(|| data.samples.iter()));
+    // What the stored records could not give back fails the report here.
+    data.innovations.status()?;
+    data.samples.status()?;
     let path = out.join("consistency.json");
     let text = serde_json::to_string_pretty(&consistency_json(&nis, nees.as_ref()))?;
     crate::line_file::write_whole(&path, text + "\n")?;
@@ -397,13 +432,15 @@ pub fn write(out: &Path, html: bool, data: &ReportData) -> Result<String> {
         let ctx = Ctx {
             dir: out.join("report"),
             data,
-            gaps: gnss_gaps(data.facts.fixes),
+            gaps: data.facts.fixes.gaps().to_vec(),
         };
         std::fs::create_dir_all(&ctx.dir)
             .with_context(|| format!("cannot create {}", ctx.dir.display()))?;
         let report = build(&ctx, &nis, nees.as_ref())?;
         let missing = report.plots_missing_units();
         debug_assert!(missing.is_empty(), "plots without units: {missing:?}");
+        data.innovations.status()?;
+        data.samples.status()?;
         report.write(&out.join("report.html"))?;
         let _ = writeln!(printed, "report: {}", out.join("report.html").display());
     }
@@ -577,12 +614,14 @@ fn position_plot(c: &Ctx, cmp: &Comparison) -> Plot {
 fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
     let data = c.data;
     let s = r.section("position", "Position error against the truth");
-    let Some((truth_path, truth)) = &data.settings.truth else {
+    let Some(truth) = &data.settings.truth else {
         s.paragraph("No truth given (--truth FILE, KF-GINS navigation text or nav.csv).");
         return Ok(());
     };
+    let truth_path = &truth.path;
     let (_, nav) = crate::formats::nav::read_nav(data.facts.nav_file)?;
-    let cmp: Comparison = compare(&nav, truth, None, None, &c.gaps).with_context(|| {
+    let truth = truth.records()?;
+    let cmp: Comparison = compare(&nav, &truth, None, None, &c.gaps).with_context(|| {
         format!(
             "comparing {} with {}",
             data.facts.nav_file.display(),
@@ -663,16 +702,23 @@ fn estimated_sensors(layout: Layout) -> impl Iterator<Item = &'static SensorQuan
     SENSORS.iter().filter(move |q| estimated[q.block])
 }
 
-/// An estimate `est` once a second with its ±3σ envelope `sd3` about it, 320 px high.
-fn estimate_plot(c: &Ctx, title: &str, y_label: &str, est: &[f64], sd3: &[f64]) -> Plot {
-    let t: Vec<f64> = c.data.samples.iter().map(|x| c.rel(x.t)).collect();
+/// An estimate once a second with its ±3σ envelope about it, 320 px high: `pick`
+/// gives a sample's `[estimate, 3σ]`.
+fn estimate_plot(
+    c: &Ctx,
+    title: &str,
+    y_label: &str,
+    pick: impl Fn(&ReportSample) -> [f64; 2],
+) -> Plot {
+    let s: Series<2> = series(|| c.data.samples.iter().map(|x| (c.rel(x.t), pick(&x))), 0);
+    let est = s.column(0);
     let mut plot = with_envelope(
         Plot::new(title, T_LABEL, y_label),
         ("estimate", "estimate ± 3σ"),
-        &t,
-        est,
-        est,
-        sd3,
+        &s.t,
+        &est,
+        &est,
+        &s.column(1),
     );
     plot.height = 320;
     plot
@@ -681,21 +727,16 @@ fn estimate_plot(c: &Ctx, title: &str, y_label: &str, est: &[f64], sd3: &[f64]) 
 /// Axis `i` of the sensor quantity `q`: the estimate ± 3σ and, with `--sensor-truth`,
 /// the truth; GNSS gaps shaded.
 fn sensor_plot(c: &Ctx, q: &SensorQuantity, i: usize, axis: &str) -> Plot {
-    let samples = c.data.samples;
-    let est: Vec<f64> = samples
-        .iter()
-        .map(|x| sensor_block(&x.estimates, q.block)[i] / q.scale)
-        .collect();
-    let sd: Vec<f64> = samples
-        .iter()
-        .map(|x| 3.0 * x.sensor_std[q.block][i] / q.scale)
-        .collect();
     let mut plot = estimate_plot(
         c,
         &format!("{} {axis}", q.name),
         &format!("{}_{axis} [{}]", q.stem, q.unit),
-        &est,
-        &sd,
+        |x| {
+            [
+                sensor_block(&x.estimates, q.block)[i] / q.scale,
+                3.0 * x.sensor_std[q.block][i] / q.scale,
+            ]
+        },
     );
     let sensor_truth = &c.data.settings.sensor_truth;
     if !sensor_truth.is_empty() {
@@ -711,24 +752,14 @@ fn sensor_plot(c: &Ctx, q: &SensorQuantity, i: usize, axis: &str) -> Plot {
 
 /// The barometer bias [m] with its ±3σ envelope; GNSS gaps shaded.
 fn baro_bias_plot(c: &Ctx) -> Plot {
-    let samples = c.data.samples;
-    let est: Vec<f64> = samples.iter().map(|x| x.estimates.baro_bias).collect();
-    let sd: Vec<f64> = samples
-        .iter()
-        .map(|x| 3.0 * x.baro_std.unwrap_or(f64::NAN))
-        .collect();
-    c.shade(estimate_plot(
-        c,
-        "Barometer bias",
-        "baro bias [m]",
-        &est,
-        &sd,
-    ))
+    c.shade(estimate_plot(c, "Barometer bias", "baro bias [m]", |x| {
+        [x.estimates.baro_bias, 3.0 * x.baro_std.unwrap_or(f64::NAN)]
+    }))
 }
 
 /// The last estimate of each estimated sensor quantity and of the barometer bias,
 /// with their 3σ (no row without a sample).
-fn final_estimates(samples: &[ReportSample], layout: Layout) -> Table {
+fn final_estimates(samples: &Spilled<ReportSample>, layout: Layout) -> Table {
     let mut table = Table::new(["quantity", "unit", "x", "y", "z", "3σ x", "3σ y", "3σ z"]);
     let Some(last) = samples.last() else {
         return table;
@@ -836,7 +867,7 @@ fn sensor_section(r: &mut Report, c: &Ctx) -> Result<()> {
                 .chain(
                     columns
                         .iter()
-                        .map(|(_, f)| Some(f(x)).filter(|v| v.is_finite())),
+                        .map(|(_, f)| Some(f(&x)).filter(|v| v.is_finite())),
                 )
                 .collect()
         }),
@@ -856,26 +887,31 @@ fn components(kind: MechanizationKind, dof: usize) -> Vec<&'static str> {
 
 fn innovation_section(r: &mut Report, c: &Ctx) -> Result<()> {
     let data = c.data;
-    let rows = &data.innovations;
+    let rows = data.innovations;
     let s = r.section("innovations", "Innovations");
     s.paragraph(
         "Innovation z = computed − measured of every measurement in the filter's frame, \
          with ±3σ of its predicted covariance S = H P Hᵀ + R; refused measurements as dots.",
     );
-    for k in nis_by_kind(rows) {
-        let of_kind: Vec<&InnovationRow> = rows.iter().filter(|r| r.kind == k.kind).collect();
-        let t: Vec<f64> = of_kind.iter().map(|r| c.rel(r.t)).collect();
+    for k in nis_by_kind(|| rows.iter()) {
         for (i, name) in components(data.facts.mechanization, k.dof)
             .into_iter()
             .enumerate()
         {
-            let pick = |keep: bool| -> Vec<f64> {
-                of_kind
-                    .iter()
-                    .map(|r| if r.accepted == keep { r.z[i] } else { f64::NAN })
-                    .collect()
+            // Per measurement: z if accepted, z if refused, 3σ, and z (the thinning's key).
+            let points = || {
+                rows.iter().filter(|r| r.kind == k.kind).map(|r| {
+                    let z = r.z[i];
+                    let (yes, no) = if r.accepted {
+                        (z, f64::NAN)
+                    } else {
+                        (f64::NAN, z)
+                    };
+                    (c.rel(r.t), [yes, no, 3.0 * r.sigma[i], z])
+                })
             };
-            let sigma: Vec<f64> = of_kind.iter().map(|r| 3.0 * r.sigma[i]).collect();
+            let series: Series<4> = series(points, 3);
+            let t = &series.t;
             let title = if name.is_empty() {
                 format!("{} innovation", k.kind)
             } else {
@@ -884,13 +920,14 @@ fn innovation_section(r: &mut Report, c: &Ctx) -> Result<()> {
             let mut plot = with_envelope(
                 Plot::new(&title, T_LABEL, &format!("z [{}]", k.kind.unit())),
                 ("accepted", "±3σ(S)"),
-                &t,
-                &pick(true),
+                t,
+                &series.column(0),
                 &vec![0.0; t.len()],
-                &sigma,
+                &series.column(2),
             );
             if k.refused > 0 {
-                plot = plot.line("refused", &t, &pick(false), LineStyle::Dotted);
+                let (t, refused) = series.ungapped(1);
+                plot = plot.line("refused", &t, &refused, LineStyle::Dotted);
             }
             plot.height = 320;
             let plot = c.shade(plot);
@@ -924,14 +961,14 @@ const TEST_HEADER: [&str; 7] = [
     "% outside the per-epoch 95 % interval",
 ];
 
+/// A statistic's values (`t` and `v` with the gaps' NaN points) against its bounds.
 fn bounds_plot(title: &str, y_label: &str, t: &[f64], v: &[f64], test: &ChiSquareTest) -> Plot {
     let (a, b) = (
         t.first().copied().unwrap_or(0.0),
         t.last().copied().unwrap_or(1.0),
     );
-    let (t, v) = gapped(t, v);
     let mut plot = Plot::new(title, T_LABEL, y_label)
-        .line("value", &t, &v, LineStyle::Solid)
+        .line("value", t, v, LineStyle::Solid)
         .line(
             &format!("{:.0} % bounds", 100.0 * PROBABILITY),
             &[a, b, f64::NAN, a, b],
@@ -955,8 +992,7 @@ fn bounds_plot(title: &str, y_label: &str, t: &[f64], v: &[f64], test: &ChiSquar
 }
 
 fn nis_section(r: &mut Report, c: &Ctx, nis: &[KindConsistency]) -> Result<()> {
-    let data = c.data;
-    let rows = &data.innovations;
+    let rows = c.data.innovations;
     let s = r.section("nis", "Consistency: normalized innovations (NIS)");
     s.paragraph(&format!(
         "NIS = zᵀ S⁻¹ z of each accepted measurement; for a consistent filter chi-square with \
@@ -969,16 +1005,17 @@ fn nis_section(r: &mut Report, c: &Ctx, nis: &[KindConsistency]) -> Result<()> {
     for k in nis {
         let Some(test) = &k.test else { continue };
         table = table.row(test_row(format!("NIS {}", k.kind), test));
-        let (t, v): (Vec<f64>, Vec<f64>) = rows
-            .iter()
-            .filter(|r| r.kind == k.kind && r.accepted)
-            .map(|r| (c.rel(r.t), r.nis))
-            .unzip();
+        let points = || {
+            rows.iter()
+                .filter(|r| r.kind == k.kind && r.accepted)
+                .map(|r| (c.rel(r.t), [r.nis]))
+        };
+        let v: Series<1> = series(points, 0);
         let plot = c.shade(bounds_plot(
             &format!("NIS, {}", k.kind),
             "NIS [-]",
-            &t,
-            &v,
+            &v.t,
+            &v.column(0),
             test,
         ));
         let svg = c.svg(&format!("nis_{}", k.kind), &plot)?;
@@ -1005,22 +1042,24 @@ fn nees_section(r: &mut Report, c: &Ctx, nees: &[Option<ChiSquareTest>; 3]) -> R
         samples
             .iter()
             .filter(|x| x.nees.is_some())
-            .map(|x| vec![Some(x.t), nees_of(x, 0), nees_of(x, 1), nees_of(x, 2)]),
+            .map(|x| vec![Some(x.t), nees_of(&x, 0), nees_of(&x, 1), nees_of(&x, 2)]),
     )?;
     let mut table = Table::new(TEST_HEADER);
     for (k, (name, test)) in NEES_BLOCKS.iter().zip(nees).enumerate() {
         let Some(test) = test else { continue };
         table = table.row(test_row(format!("NEES {name}"), test));
-        let (t, v): (Vec<f64>, Vec<f64>) = samples
-            .iter()
-            .filter(|x| x.nees.is_some())
-            .map(|x| (c.rel(x.t), nees_of(x, k).unwrap_or(f64::NAN)))
-            .unzip();
+        let points = || {
+            samples
+                .iter()
+                .filter(|x| x.nees.is_some())
+                .map(|x| (c.rel(x.t), [nees_of(&x, k).unwrap_or(f64::NAN)]))
+        };
+        let v: Series<1> = series(points, 0);
         let plot = c.shade(bounds_plot(
             &format!("NEES, {name}"),
             "NEES [-]",
-            &t,
-            &v,
+            &v.t,
+            &v.column(0),
             test,
         ));
         let svg = c.svg(&format!("nees_{name}"), &plot)?;
@@ -1056,7 +1095,7 @@ mod tests {
             row(2.0, Kind::GnssPosition, 3, 2500.0, false),
             row(3.0, Kind::GnssPosition, 3, 10.0, true),
         ];
-        let k = nis_by_kind(&rows);
+        let k = nis_by_kind(|| rows.iter().copied());
         assert_eq!(
             k.iter()
                 .map(|k| (k.kind, k.dof, k.accepted, k.refused))

@@ -115,7 +115,10 @@ pub fn navigate(c: &CampaignConfig, data: &Recorded) -> Result<Navigated> {
     let mut aiding = resolve_aiding(&plan.alignment, &plan.aiding, readings)?;
     if let Some(a) = aiding.as_mut() {
         a.report.html = false;
-        a.report.truth = Some(("<simulated truth>".into(), data.truth.clone()));
+        a.report.truth = Some(crate::aided::report::Truth {
+            path: "<simulated truth>".into(),
+            held: Some(data.truth.clone()),
+        });
         a.names.diagnostics = true;
     }
     let settings = &plan.settings;

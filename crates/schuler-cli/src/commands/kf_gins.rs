@@ -337,7 +337,7 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
         out_bag: None,
     };
     let aiding = Aiding {
-        fixes,
+        fixes: fixes.into(),
         filter: FilterConfig::new(integration(
             &y,
             &key,

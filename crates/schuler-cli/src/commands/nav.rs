@@ -480,7 +480,7 @@ where
     E: std::error::Error + Send + Sync + 'static,
 {
     let (start, head, m) = motion_start(settings, reader, aiding.as_deref_mut(), init)?;
-    let fixes = aiding.map(|a| &a.fixes[..]).unwrap_or_default();
+    let fixes = aiding.map(|a| &a.fixes);
     let e = m.state.euler();
     let heading = match init {
         InitChoice::Gnss => format!(
@@ -490,7 +490,11 @@ where
         ),
         _ => format!("heading unknown: a bank of {BANK_MEMBERS} filters searches it"),
     };
-    let fix_t = |i: usize| fixes.get(i).map_or(f64::NAN, |f| f.t);
+    let fix_t = |i: usize| {
+        fixes
+            .and_then(|f| f.iter().nth(i))
+            .map_or(f64::NAN, |f| f.t)
+    };
     println!(
         "started in motion at t = {} s from the fixes at {} and {} s: {:.2} m/s, {heading}, roll {:.2} pitch {:.2} ± {:.2} deg",
         m.state.t,
@@ -529,7 +533,8 @@ where
     let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
         bail!("--init {init:?} needs GNSS fixes (--gnss FILE)");
     };
-    let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &aiding.fixes);
+    let all = aiding.fixes.to_vec()?;
+    let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &all);
     let context = || format!("--init gnss: {}", settings.imu.display());
     let first = match reader.next() {
         Some(s) => s?,

@@ -11,7 +11,8 @@
 //! comments are skipped. The time is the second of week; in a KF-GINS file a later week continues
 //! it (`sow + 604800 (week - first week)`), so a rollover inside a file is no step, but
 //! the weeks of two files are not compared (schuler writes week 0 where it knows none).
-//! A file is read whole (80 bytes per epoch).
+//! [`NavReader`] reads a file an epoch at a time; [`read_nav`] reads it whole (80
+//! bytes per epoch).
 
 use super::error::{InputError, InputErrorKind, quote_field};
 use super::gps_time::WeekClock;
@@ -21,7 +22,7 @@ use schuler::analysis::errors::NavRecord;
 use schuler::earth::Geodetic;
 use schuler::rotation::Euler;
 use std::io::{BufRead, BufReader, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The layouts [`read_nav`] tells apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,7 +171,7 @@ fn record(
     n: u64,
     v: [f64; 10],
     names: &[&str; 10],
-    prev: Option<&NavRecord>,
+    prev_t: Option<f64>,
 ) -> Result<NavRecord, InputError> {
     let at = |field: &str, kind, msg: String| InputError::new(kind, path, n, Some(field), msg);
     if !(-90.0..=90.0).contains(&v[1]) {
@@ -180,13 +181,13 @@ fn record(
             format!("latitude {} is outside [-90, 90]", v[1]),
         ));
     }
-    if let Some(prev) = prev
-        && v[0] <= prev.t_sow
+    if let Some(prev) = prev_t
+        && v[0] <= prev
     {
         return Err(at(
             names[0],
             InputErrorKind::TimeNotIncreasing,
-            format!("time {} does not increase (previous {})", v[0], prev.t_sow),
+            format!("time {} does not increase (previous {prev})", v[0]),
         ));
     }
     Ok(NavRecord {
@@ -197,70 +198,141 @@ fn record(
     })
 }
 
-/// Reads a navigation file whole (either layout, told by its first data line),
-/// checking column counts, numbers, finiteness, latitude range, whole weeks and
-/// strictly increasing time; errors name the file, line and field.
-pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> {
-    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, e))?;
-    let mut reader = BufReader::with_capacity(1 << 20, file);
-    let mut buf: Vec<u8> = Vec::new();
-    let mut n: u64 = 0;
-    let mut format = None;
-    let mut csv_columns: CsvColumns = (Delimiter::Blanks, 0, [0; 10]);
-    let mut clock = WeekClock::default();
-    let mut rows: Vec<NavRecord> = Vec::new();
-    loop {
-        buf.clear();
-        if (&mut reader)
-            .take(MAX_LINE_BYTES)
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| cannot_read(path, e))?
-            == 0
-        {
-            break;
-        }
-        n += 1;
-        if buf.last() != Some(&b'\n') && buf.len() as u64 == MAX_LINE_BYTES {
-            return Err(too_long(path, n));
-        }
-        let text = if n == 1 {
-            buf.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&buf)
-        } else {
-            &buf
-        };
-        let l = std::str::from_utf8(text)
-            .map_err(|_| {
-                InputError::new(InputErrorKind::NotANumber, path, n, None, "not UTF-8 text")
-            })?
-            .trim();
-        if is_skippable(l.as_bytes()) {
-            continue;
-        }
-        let fmt = match format {
-            Some(f) => f,
-            None if l.starts_with(|c: char| c.is_ascii_alphabetic() || c == '"') => {
-                csv_columns = csv_header(path, n, l)?;
-                format = Some(NavFormat::Csv);
+/// A navigation file read one epoch at a time (either layout, told by its first data
+/// line), checking column counts, numbers, finiteness, latitude range, whole weeks and
+/// strictly increasing time; errors name the file, line and field. It holds one line,
+/// so a truth of any length streams in constant memory. After an error it ends.
+#[derive(Debug)]
+pub struct NavReader {
+    path: PathBuf,
+    reader: BufReader<std::fs::File>,
+    buf: Vec<u8>,
+    n: u64,
+    format: Option<NavFormat>,
+    csv_columns: CsvColumns,
+    clock: WeekClock,
+    prev_t: Option<f64>,
+    ended: bool,
+}
+
+impl NavReader {
+    /// Opens `path`.
+    pub fn open(path: &Path) -> Result<Self, InputError> {
+        let file = std::fs::File::open(path).map_err(|e| cannot_read(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader: BufReader::with_capacity(1 << 16, file),
+            buf: Vec::new(),
+            n: 0,
+            format: None,
+            csv_columns: (Delimiter::Blanks, 0, [0; 10]),
+            clock: WeekClock::default(),
+            prev_t: None,
+            ended: false,
+        })
+    }
+
+    /// The layout, once the first data line is read.
+    pub fn format(&self) -> Option<NavFormat> {
+        self.format
+    }
+
+    /// The next epoch, `None` at the end of the file.
+    fn next_record(&mut self) -> Result<Option<NavRecord>, InputError> {
+        let path = self.path.as_path();
+        loop {
+            self.buf.clear();
+            if (&mut self.reader)
+                .take(MAX_LINE_BYTES)
+                .read_until(b'\n', &mut self.buf)
+                .map_err(|e| cannot_read(path, e))?
+                == 0
+            {
+                return Ok(None);
+            }
+            self.n += 1;
+            let n = self.n;
+            if self.buf.last() != Some(&b'\n') && self.buf.len() as u64 == MAX_LINE_BYTES {
+                return Err(too_long(path, n));
+            }
+            let text = if n == 1 {
+                self.buf.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&self.buf)
+            } else {
+                &self.buf
+            };
+            let l = std::str::from_utf8(text)
+                .map_err(|_| {
+                    InputError::new(InputErrorKind::NotANumber, path, n, None, "not UTF-8 text")
+                })?
+                .trim();
+            if is_skippable(l.as_bytes()) {
                 continue;
             }
-            None => *format.insert(NavFormat::KfGins),
-        };
-        let (v, names) = match fmt {
-            NavFormat::KfGins => (kf_gins_values(path, n, l, &mut clock)?, &KF_GINS_VALUES),
-            NavFormat::Csv => (csv_values(path, n, l, &csv_columns)?, &CSV_FIELDS),
-        };
-        let r = record(path, n, v, names, rows.last())?;
-        rows.push(r);
+            let fmt = match self.format {
+                Some(f) => f,
+                None if l.starts_with(|c: char| c.is_ascii_alphabetic() || c == '"') => {
+                    self.csv_columns = csv_header(path, n, l)?;
+                    self.format = Some(NavFormat::Csv);
+                    continue;
+                }
+                None => *self.format.insert(NavFormat::KfGins),
+            };
+            let (v, names) = match fmt {
+                NavFormat::KfGins => (
+                    kf_gins_values(path, n, l, &mut self.clock)?,
+                    &KF_GINS_VALUES,
+                ),
+                NavFormat::Csv => (csv_values(path, n, l, &self.csv_columns)?, &CSV_FIELDS),
+            };
+            let r = record(path, n, v, names, self.prev_t)?;
+            self.prev_t = Some(r.t_sow);
+            return Ok(Some(r));
+        }
     }
-    match format {
+}
+
+impl Iterator for NavReader {
+    type Item = Result<NavRecord, InputError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.ended {
+            return None;
+        }
+        let r = self.next_record().transpose();
+        if !matches!(r, Some(Ok(_))) {
+            self.ended = true;
+        }
+        r
+    }
+}
+
+/// The error of a file without a data line.
+fn no_data(path: &Path) -> InputError {
+    InputError::new(InputErrorKind::NoData, path, 0, None, "no data line")
+}
+
+/// Reads a navigation file whole ([`NavReader`]'s checks; 80 bytes per epoch).
+pub fn read_nav(path: &Path) -> Result<(NavFormat, Vec<NavRecord>), InputError> {
+    let mut reader = NavReader::open(path)?;
+    let rows = (&mut reader).collect::<Result<Vec<NavRecord>, InputError>>()?;
+    match reader.format() {
         Some(f) if !rows.is_empty() => Ok((f, rows)),
-        _ => Err(InputError::new(
-            InputErrorKind::NoData,
-            path,
-            0,
-            None,
-            "no data line",
-        )),
+        _ => Err(no_data(path)),
+    }
+}
+
+/// Checks a navigation file through to its end without keeping it (as [`read_nav`]
+/// would refuse it); its layout and number of epochs.
+pub fn check_nav(path: &Path) -> Result<(NavFormat, u64), InputError> {
+    let mut reader = NavReader::open(path)?;
+    let mut epochs = 0u64;
+    for r in &mut reader {
+        r?;
+        epochs += 1;
+    }
+    match reader.format() {
+        Some(f) if epochs > 0 => Ok((f, epochs)),
+        _ => Err(no_data(path)),
     }
 }
 
