@@ -5,7 +5,7 @@
 //! crate writes them by default), navigated end to end through the 21-state filter
 //! with 1-Hz output: the GNSS read, the IMU streamed, nav.txt written.
 
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group};
 use mcap::records::MessageHeader;
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::imu::ImuSample;
@@ -130,56 +130,109 @@ fn setup() -> (PathBuf, NavSettings) {
     (dir, settings)
 }
 
+/// The two runs compared: the KF-GINS text path and the bag path, each end to end.
+struct Runs {
+    dir: PathBuf,
+    settings: NavSettings,
+}
+
+impl Runs {
+    fn options(
+        gnss: Option<PathBuf>,
+        bag: Option<schuler_cli::bag::input::BagAids>,
+    ) -> AidingOptions {
+        AidingOptions {
+            gnss,
+            bag,
+            scale_factors: true,
+            no_report: true,
+            ..Default::default()
+        }
+    }
+
+    fn text(&self) {
+        let noise = GradeChoice::Tactical.noise().expect("preset");
+        let aiding = Self::options(Some(self.dir.join("gnss.txt")), None)
+            .resolve(noise)
+            .expect("aiding");
+        let s = &self.settings;
+        let mut reader = ImuReader::open(&s.imu, &s.read).expect("open");
+        navigate(Wgs84, s, aiding.as_ref(), s.start(), &mut reader, |_| {}).expect("navigate");
+    }
+
+    fn bag(&self) {
+        let noise = GradeChoice::Tactical.noise().expect("preset");
+        let p = plan(&self.dir.join("drive.mcap"), &BagReadOptions::default()).expect("plan");
+        let aiding = Self::options(None, Some(p.aids.clone()))
+            .resolve(noise)
+            .expect("aiding");
+        let samples = p.imu_samples().expect("samples");
+        let s = &self.settings;
+        navigate(Wgs84, s, aiding.as_ref(), s.start(), samples, |_| {}).expect("navigate");
+    }
+}
+
 fn bench_bag(c: &mut Criterion) {
     let (dir, settings) = setup();
-    let noise = GradeChoice::Tactical.noise().expect("preset");
-    let options = |gnss: Option<PathBuf>, bag| AidingOptions {
-        gnss,
-        bag,
-        scale_factors: true,
-        no_report: true,
-        ..Default::default()
-    };
+    let runs = Runs { dir, settings };
     let mut group = c.benchmark_group("nav_bag");
     group.sample_size(10);
     group.throughput(Throughput::Elements((SECONDS as f64 * RATE_HZ) as u64));
-    group.bench_function("text_1h_200hz_gnss_10hz", |b| {
-        b.iter(|| {
-            let aiding = options(Some(dir.join("gnss.txt")), None)
-                .resolve(noise)
-                .expect("aiding");
-            let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
-            navigate(
-                Wgs84,
-                &settings,
-                aiding.as_ref(),
-                settings.start(),
-                &mut reader,
-                |_| {},
-            )
-            .expect("navigate")
-        })
-    });
-    group.bench_function("bag_1h_200hz_gnss_10hz", |b| {
-        b.iter(|| {
-            let p = plan(&dir.join("drive.mcap"), &BagReadOptions::default()).expect("plan");
-            let aiding = options(None, Some(p.aids.clone()))
-                .resolve(noise)
-                .expect("aiding");
-            let samples = p.imu_samples().expect("samples");
-            navigate(
-                Wgs84,
-                &settings,
-                aiding.as_ref(),
-                settings.start(),
-                samples,
-                |_| {},
-            )
-            .expect("navigate")
-        })
-    });
+    group.bench_function("text_1h_200hz_gnss_10hz", |b| b.iter(|| runs.text()));
+    group.bench_function("bag_1h_200hz_gnss_10hz", |b| b.iter(|| runs.bag()));
     group.finish();
 }
 
+/// This process's CPU time so far (user + system, every thread) [s], from
+/// `/proc/self/stat` (fields 14 and 15, in clock ticks of 1/100 s).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").expect("/proc/self/stat");
+    // The command name (field 2) is in parentheses and may hold blanks.
+    let after = &stat[stat.rfind(')').expect("stat") + 2..];
+    let f: Vec<f64> = after
+        .split_whitespace()
+        .skip(11)
+        .take(2)
+        .map(|x| x.parse().expect("ticks"))
+        .collect();
+    (f[0] + f[1]) / 100.0
+}
+
+/// `--cpu N`: N alternating pairs of runs (text, then bag), each timed by the CPU
+/// time it took (every thread, so the writer thread counts; less sensitive to the
+/// machine's load than wall time), and the ratio bag/text of each pair and of the sums.
+fn cpu_pairs(n: usize) {
+    let (dir, settings) = setup();
+    let runs = Runs { dir, settings };
+    let (mut text_sum, mut bag_sum) = (0.0, 0.0);
+    println!("| pair | text CPU [s] | bag CPU [s] | bag/text |");
+    println!("|---|---|---|---|");
+    for k in 1..=n {
+        let t0 = cpu_seconds();
+        runs.text();
+        let t1 = cpu_seconds();
+        runs.bag();
+        let t2 = cpu_seconds();
+        let (text, bag) = (t1 - t0, t2 - t1);
+        text_sum += text;
+        bag_sum += bag;
+        println!("| {k} | {text:.2} | {bag:.2} | {:.2} |", bag / text);
+    }
+    println!(
+        "| all | {text_sum:.2} | {bag_sum:.2} | {:.2} |",
+        bag_sum / text_sum
+    );
+}
+
 criterion_group!(benches, bench_bag);
-criterion_main!(benches);
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(k) = args.iter().position(|a| a == "--cpu") {
+        let n = args.get(k + 1).and_then(|x| x.parse().ok()).unwrap_or(5);
+        cpu_pairs(n);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
