@@ -73,6 +73,21 @@ impl From<Vec<GnssFix>> for Fixes {
 }
 
 impl Fixes {
+    /// Adds `fix`, later than every fix before it.
+    pub fn push(&mut self, fix: &GnssFix) {
+        self.store.push(fix);
+        self.first.get_or_insert(*fix);
+        self.last = Some(*fix);
+    }
+
+    /// The store with its gaps, once every fix is pushed (they need the median
+    /// spacing of all of them: 8 bytes a fix, for the time of this call).
+    pub fn closed(mut self) -> Self {
+        let times: Vec<f64> = self.iter().map(|f| f.t).collect();
+        self.gaps = super::report::gaps_of_times(&times);
+        self
+    }
+
     /// How many.
     pub fn len(&self) -> usize {
         self.store.len()
@@ -109,6 +124,11 @@ impl Fixes {
         let all = self.iter().collect();
         self.status()?;
         Ok(all)
+    }
+
+    /// Bytes of fixes held in memory (the rest is on disk).
+    pub fn in_memory(&self) -> usize {
+        self.store.in_memory()
     }
 
     /// An error if the store failed (a full temporary disk).

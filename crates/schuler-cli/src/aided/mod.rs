@@ -483,9 +483,8 @@ impl AidingOptions {
             }
             return Ok(None);
         }
-        let mut fixes = self.fixes(given.fixes)?;
+        let (fixes, outage_test) = self.fix_store(given.fixes)?;
         let noise = self.noise(noise)?;
-        let outage_test = self.outage_test(&mut fixes)?;
         let (baro, baro_std) = self.baro(given.baro)?;
         let (vehicle_cfg, vehicle) = vehicle::resolve(self, &noise)?;
         let mut integration = self.integration(noise)?;
@@ -506,7 +505,7 @@ impl AidingOptions {
             outage_test,
             baro,
             report: self.report()?,
-            fixes: fixes.into(),
+            fixes,
         }))
     }
 
@@ -525,15 +524,63 @@ impl AidingOptions {
         })
     }
 
-    /// The GNSS fixes (the reader's warnings printed), with the velocities of
-    /// `--gnss-vel` merged in and `--gnss-time-offset` added to their times.
-    /// `given`: fixes in memory in place of the file.
-    pub fn fixes(&self, given: Option<Vec<GnssFix>>) -> Result<Vec<GnssFix>> {
+    /// The GNSS fixes of the run in their store, and the outage test cut from them.
+    /// A text `--gnss` log (KF-GINS text or CSV) without `--gnss-vel` and
+    /// `--outage-test` is streamed into the store line by line, so that its memory
+    /// does not grow with the log's length (issue 22); the other formats are read
+    /// whole ([`AidingOptions::fixes`]) and then stored.
+    fn fix_store(&self, given: Option<Vec<GnssFix>>) -> Result<(fixes::Fixes, Option<OutageTest>)> {
+        if let (None, Some(path), None, None) =
+            (&given, &self.gnss, &self.gnss_vel, &self.outage_test)
+        {
+            let vel_std = self.gnss_vel_std()?;
+            let opts = self.gnss_read_options(vel_std)?;
+            if crate::formats::gnss::format_of(path, opts.format)? == GnssFormat::Text {
+                let offset = self.gnss_time_offset()?;
+                let mut store = fixes::Fixes::default();
+                crate::formats::gnss::for_each_text_record(path, opts.default_std, |r| {
+                    let mut fix = r.fix;
+                    if let Some(dt) = offset {
+                        fix.t += dt;
+                    }
+                    store.push(&fix);
+                })?;
+                return Ok((store.closed(), None));
+            }
+        }
+        let mut fixes = self.fixes(given)?;
+        let outage_test = self.outage_test(&mut fixes)?;
+        Ok((fixes.into(), outage_test))
+    }
+
+    /// `--gnss-vel-std` [m/s] (0.1 when not given), which must be positive.
+    fn gnss_vel_std(&self) -> Result<f64> {
         let vel_std =
             quantity("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
         if vel_std <= 0.0 {
             bail!("--gnss-vel-std must be positive");
         }
+        Ok(vel_std)
+    }
+
+    /// `--gnss-time-offset` [s], which must be finite.
+    fn gnss_time_offset(&self) -> Result<Option<f64>> {
+        let Some(text) = &self.gnss_time_offset else {
+            return Ok(None);
+        };
+        let dt = parse_as_or_si(text.trim(), Dimension::Time)
+            .with_context(|| format!("--gnss-time-offset {text:?}"))?;
+        if !dt.is_finite() {
+            bail!("--gnss-time-offset must be finite, got {text:?}");
+        }
+        Ok(Some(dt))
+    }
+
+    /// The GNSS fixes (the reader's warnings printed), with the velocities of
+    /// `--gnss-vel` merged in and `--gnss-time-offset` added to their times.
+    /// `given`: fixes in memory in place of the file.
+    pub fn fixes(&self, given: Option<Vec<GnssFix>>) -> Result<Vec<GnssFix>> {
+        let vel_std = self.gnss_vel_std()?;
         let mut fixes = match (given, &self.gnss) {
             (Some(given), _) => given,
             (None, Some(gnss)) => {
@@ -558,12 +605,7 @@ impl AidingOptions {
                 );
             }
         }
-        if let Some(text) = &self.gnss_time_offset {
-            let dt = parse_as_or_si(text.trim(), Dimension::Time)
-                .with_context(|| format!("--gnss-time-offset {text:?}"))?;
-            if !dt.is_finite() {
-                bail!("--gnss-time-offset must be finite, got {text:?}");
-            }
+        if let Some(dt) = self.gnss_time_offset()? {
             for f in &mut fixes {
                 f.t += dt;
             }
@@ -866,4 +908,50 @@ pub fn report_outage_test(
         &serde_json::json!({ "outages": json, "rms_of_maxima": rms }),
     )?;
     crate::line_file::write_whole(&path, text + "\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A text GNSS log streamed into the store (with a time offset) holds the fixes
+    /// the whole-file reader gives, bit for bit, with the same ends and gaps, while
+    /// at most the store's budget stays in memory; with `--outage-test` (read whole)
+    /// the store is the same too.
+    #[test]
+    fn a_streamed_text_log_equals_the_log_read_whole() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("gnss.txt");
+        let mut text = String::from("# t lat lon h std_n std_e std_d\n");
+        for k in 1..=20_000u32 {
+            // A 60-s outage after 500 s, and a 13-column row now and then.
+            let t = f64::from(k) + if k > 500 { 60.0 } else { 0.0 };
+            let lat = 30.5 + 1e-7 * f64::from(k);
+            text.push_str(&format!(
+                "{t} {lat:.10} 114.3 {} 0.5 0.5 1.0",
+                20.0 + 0.01 * f64::from(k)
+            ));
+            if k % 7 == 0 {
+                text.push_str(" 1.5 -0.5 0.1 0.1 0.1 0.2");
+            }
+            text.push('\n');
+        }
+        std::fs::write(&path, text).expect("write");
+        let options = AidingOptions {
+            gnss: Some(path),
+            gnss_time_offset: Some("-2.5 s".into()),
+            ..Default::default()
+        };
+        let whole = options.fixes(None).expect("read whole");
+        let (streamed, outage) = options.fix_store(None).expect("streamed");
+        assert!(outage.is_none());
+        assert_eq!(streamed.to_vec().expect("read back"), whole);
+        assert_eq!(
+            (streamed.first(), streamed.last()),
+            (whole.first().copied(), whole.last().copied())
+        );
+        assert_eq!(streamed.gaps(), report::gnss_gaps(&whole));
+        assert_eq!(streamed.gaps(), [(497.5, 558.5)]);
+        assert!(streamed.in_memory() <= spilled::BUDGET);
+    }
 }

@@ -289,16 +289,21 @@ pub fn consistency_text(
 /// GNSS gaps: intervals between consecutive fixes more than twice the median spacing
 /// apart (outages, given or cut by `--outage-test`).
 pub fn gnss_gaps(fixes: &[GnssFix]) -> Vec<(f64, f64)> {
-    if fixes.len() < 3 {
+    let times: Vec<f64> = fixes.iter().map(|f| f.t).collect();
+    gaps_of_times(&times)
+}
+
+/// [`gnss_gaps`] of the fixes' times `t` [s].
+pub fn gaps_of_times(t: &[f64]) -> Vec<(f64, f64)> {
+    if t.len() < 3 {
         return Vec::new();
     }
-    let mut dt: Vec<f64> = fixes.windows(2).map(|w| w[1].t - w[0].t).collect();
+    let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
     dt.sort_unstable_by(f64::total_cmp);
     let median = dt[dt.len() / 2];
-    fixes
-        .windows(2)
-        .filter(|w| w[1].t - w[0].t > 2.0 * median)
-        .map(|w| (w[0].t, w[1].t))
+    t.windows(2)
+        .filter(|w| w[1] - w[0] > 2.0 * median)
+        .map(|w| (w[0], w[1]))
         .collect()
 }
 

@@ -302,11 +302,16 @@ fn integration(
 pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
     let y = read_yaml(path)?;
     let key = |k: &str| format!("{}: {k}", path.display());
-    let mut fixes = crate::formats::gnss::read_gnss(&y.gnsspath)
-        .with_context(|| format!("{}: gnsspath", path.display()))?;
     // KF-GINS skips the fixes up to and including `starttime` (its start is the
-    // configured state, not a fix).
-    fixes.retain(|f| f.t > y.starttime && (y.endtime < 0.0 || f.t <= y.endtime));
+    // configured state, not a fix). The log is streamed into the store (memory
+    // bounded whatever its length); it must give standard deviations.
+    let mut fixes = crate::aided::fixes::Fixes::default();
+    crate::formats::gnss::for_each_text_record(&y.gnsspath, None, |r| {
+        if r.fix.t > y.starttime && (y.endtime < 0.0 || r.fix.t <= y.endtime) {
+            fixes.push(&r.fix);
+        }
+    })
+    .with_context(|| format!("{}: gnsspath", path.display()))?;
     let settings = NavSettings {
         imu: y.imupath.clone(),
         read: ImuReadOptions {
@@ -337,7 +342,7 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
         out_bag: None,
     };
     let aiding = Aiding {
-        fixes: fixes.into(),
+        fixes: fixes.closed(),
         filter: FilterConfig::new(integration(
             &y,
             &key,

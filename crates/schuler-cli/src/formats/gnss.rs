@@ -102,10 +102,6 @@ const SAME_HEIGHT_M: f64 = 100.0;
 /// Numbers of data lines, each with its 1-based line number.
 type Rows = Vec<(u64, Vec<f64>)>;
 
-/// Position rows, each with its 1-based line number and its outlier flag (a CSV's
-/// `outlier` column).
-type FlaggedRows = Vec<(u64, Vec<f64>, Option<bool>)>;
-
 /// The position log formats [`read_gnss_log`] reads (`--gnss-format`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -373,21 +369,7 @@ fn text_rows<'a>(
 ) -> Result<Rows, InputError> {
     let mut rows: Rows = Vec::new();
     for (n, l) in lines {
-        let fields: Vec<&str> = fields(l).collect();
-        if !counts.contains(&fields.len()) {
-            return Err(InputError::new(
-                InputErrorKind::ColumnCount,
-                path,
-                n,
-                None,
-                wrong_count(fields.len()),
-            ));
-        }
-        let v = fields
-            .iter()
-            .zip(names)
-            .map(|(f, name)| parse_field(path, n, name, f, ""))
-            .collect::<Result<Vec<f64>, _>>()?;
+        let v = text_row(path, (n, l), names, counts, wrong_count)?;
         check_time(path, n, names[0], v[0], rows.last().map(|r| r.1[0]))?;
         rows.push((n, v));
     }
@@ -395,6 +377,32 @@ fn text_rows<'a>(
         return Err(no_data(path));
     }
     Ok(rows)
+}
+
+/// The values of headerless line `n` (text `l`), whose field count must be one of
+/// `counts` (else `wrong_count` says why), each parsed as the field `names` names.
+fn text_row(
+    path: &Path,
+    (n, l): (u64, &str),
+    names: &[&str],
+    counts: &[usize],
+    wrong_count: &dyn Fn(usize) -> String,
+) -> Result<Vec<f64>, InputError> {
+    let fields: Vec<&str> = fields(l).collect();
+    if !counts.contains(&fields.len()) {
+        return Err(InputError::new(
+            InputErrorKind::ColumnCount,
+            path,
+            n,
+            None,
+            wrong_count(fields.len()),
+        ));
+    }
+    fields
+        .iter()
+        .zip(names)
+        .map(|(f, name)| parse_field(path, n, name, f, ""))
+        .collect()
 }
 
 /// A CSV log's header line: the column names as written, each trimmed of blanks and
@@ -536,25 +544,7 @@ impl<'a> CsvHeader<'a> {
     ) -> Result<Rows, InputError> {
         let mut rows: Rows = Vec::new();
         for (n, l) in lines {
-            let fields = self.delimiter.split(l);
-            if fields.len() != self.names.len() {
-                return Err(InputError::new(
-                    InputErrorKind::ColumnCount,
-                    self.path,
-                    n,
-                    None,
-                    format!(
-                        "{} columns, the header (line {}) names {}",
-                        fields.len(),
-                        self.line,
-                        self.names.len()
-                    ),
-                ));
-            }
-            let v = cols
-                .iter()
-                .map(|&(c, name)| parse_field(self.path, n, name, fields[c], std_hint))
-                .collect::<Result<Vec<f64>, _>>()?;
+            let v = self.row(n, l, cols, std_hint)?;
             check_time(self.path, n, cols[0].1, v[0], rows.last().map(|r| r.1[0]))?;
             rows.push((n, v));
         }
@@ -562,6 +552,35 @@ impl<'a> CsvHeader<'a> {
             return Err(no_data(self.path));
         }
         Ok(rows)
+    }
+
+    /// The values of the columns `cols` of line `n` (text `l`), which must have as
+    /// many fields as the header names.
+    fn row(
+        &self,
+        n: u64,
+        l: &str,
+        cols: &[(usize, &str)],
+        std_hint: &str,
+    ) -> Result<Vec<f64>, InputError> {
+        let fields = self.delimiter.split(l);
+        if fields.len() != self.names.len() {
+            return Err(InputError::new(
+                InputErrorKind::ColumnCount,
+                self.path,
+                n,
+                None,
+                format!(
+                    "{} columns, the header (line {}) names {}",
+                    fields.len(),
+                    self.line,
+                    self.names.len()
+                ),
+            ));
+        }
+        cols.iter()
+            .map(|&(c, name)| parse_field(self.path, n, name, fields[c], std_hint))
+            .collect()
     }
 }
 
@@ -593,14 +612,11 @@ fn outlier_flag(path: &Path, n: u64, x: Option<f64>) -> Result<Option<bool>, Inp
     }
 }
 
-/// Rows of a position CSV after its header `h`: the required columns in
-/// [`CSV_POS`] order, the standard deviations where the header names them, and the
-/// outlier flag where it names it.
-fn csv_position_rows<'l>(
-    path: &Path,
+/// The columns a CSV position log's header `h` gives (time, position, and the
+/// standard deviations if any), and the place of its outlier column if it has one.
+fn csv_position_cols(
     h: &CsvHeader,
-    lines: impl Iterator<Item = (u64, &'l str)>,
-) -> Result<FlaggedRows, InputError> {
+) -> Result<(Vec<(usize, &'static str)>, Option<usize>), InputError> {
     let mut cols: Vec<(usize, &str)> = h
         .require(&CSV_POS, "a GNSS position log", "")?
         .into_iter()
@@ -611,12 +627,7 @@ fn csv_position_rows<'l>(
     if let Some(c) = outlier {
         cols.push((c, CSV_OUTLIER));
     }
-    let mut out = Vec::new();
-    for (n, mut v) in h.rows(lines, &cols, "")? {
-        let flag = outlier_flag(path, n, outlier.and_then(|_| v.pop()))?;
-        out.push((n, v, flag));
-    }
-    Ok(out)
+    Ok((cols, outlier))
 }
 
 /// The position of latitude, longitude [deg] and height [m] after the checks of
@@ -712,37 +723,53 @@ pub fn read_text_records(
     path: &Path,
     default_std: Option<Vector3<f64>>,
 ) -> Result<Vec<GnssRecord>, InputError> {
-    let text = read_text(path)?;
-    let mut lines = data_lines(&text).peekable();
-    let header = match lines.peek() {
-        Some(&(n, l)) if is_header(l) => {
-            lines.next();
-            Some(CsvHeader::parse(path, n, l))
+    let mut records = Vec::new();
+    for_each_text_record(path, default_std, |r| records.push(r))?;
+    Ok(records)
+}
+
+/// [`read_text_records`] one record at a time, each handed to `sink` as its line is
+/// read, so that memory is bounded by a line whatever the log's length. The first
+/// error in the file's order is returned.
+pub fn for_each_text_record(
+    path: &Path,
+    default_std: Option<Vector3<f64>>,
+    mut sink: impl FnMut(GnssRecord),
+) -> Result<(), InputError> {
+    type Csv<'a> = (CsvHeader<'a>, Vec<(usize, &'static str)>, Option<usize>);
+    let (mut first, mut csv, mut prev): (bool, Option<Csv>, Option<f64>) = (true, None, None);
+    super::lines::for_each_data_line(path, |n, l| {
+        if std::mem::take(&mut first) && is_header(l) {
+            let h = CsvHeader::parse(path, n, l);
+            let (cols, outlier) = csv_position_cols(&h)?;
+            csv = Some((h, cols, outlier));
+            return Ok(());
         }
-        _ => None,
-    };
-    // Rows as `t lat lon h [std_n std_e std_d [vn ve vd std_vn std_ve std_vd]]`, and
-    // the outlier flag.
-    let (rows, names) = match &header {
-        None => {
-            let rows = text_rows(path, lines, &POS_FIELDS, &[4, 7, 13], &|k| {
-                format!("{k} columns, expected [4, 7, 13]")
-            })?;
-            (
-                rows.into_iter()
-                    .map(|(n, v)| (n, v, None))
-                    .collect::<Vec<_>>(),
-                (["lat", "lon", "h"], "std_n"),
-            )
-        }
-        Some(h) => (
-            csv_position_rows(path, h, lines)?,
-            (["lat_deg", "lon_deg", "h_m"], "std_n_m"),
-        ),
-    };
-    rows.into_iter()
-        .map(|(n, v, outlier)| gnss_record(path, n, &v, outlier, names, default_std))
-        .collect()
+        // `t lat lon h [std_n std_e std_d [vn ve vd std_vn std_ve std_vd]]`, the
+        // outlier flag, and the names errors give the time, position and std fields.
+        let (v, outlier, (t_name, names)) = match &csv {
+            None => {
+                let v = text_row(path, (n, l), &POS_FIELDS, &[4, 7, 13], &|k| {
+                    format!("{k} columns, expected [4, 7, 13]")
+                })?;
+                (v, None, (POS_FIELDS[0], (["lat", "lon", "h"], "std_n")))
+            }
+            Some((h, cols, outlier)) => {
+                let mut v = h.row(n, l, cols, "")?;
+                let flag = outlier_flag(path, n, outlier.and_then(|_| v.pop()))?;
+                let names = (["lat_deg", "lon_deg", "h_m"], "std_n_m");
+                (v, flag, (cols[0].1, names))
+            }
+        };
+        check_time(path, n, t_name, v[0], prev)?;
+        prev = Some(v[0]);
+        sink(gnss_record(path, n, &v, outlier, names, default_std)?);
+        Ok(())
+    })?;
+    match prev {
+        Some(_) => Ok(()),
+        None => Err(no_data(path)),
+    }
 }
 
 /// Read a GNSS position log of text (KF-GINS text or CSV with a header, see the
@@ -798,6 +825,19 @@ fn detect(bytes: &[u8]) -> GnssFormat {
         }
     }
     GnssFormat::Text
+}
+
+/// The format `format` names, or with [`GnssFormat::Auto`] the one the start of the
+/// file `path` shows ([`detect`] on its first 200 lines, at most 1 MiB).
+pub fn format_of(path: &Path, format: GnssFormat) -> Result<GnssFormat, InputError> {
+    if format != GnssFormat::Auto {
+        return Ok(format);
+    }
+    let file = std::fs::File::open(path).map_err(|e| super::lines::cannot_read(path, &e))?;
+    let mut head = Vec::new();
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, 1 << 20), &mut head)
+        .map_err(|e| super::lines::cannot_read(path, &e))?;
+    Ok(detect(head.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&head)))
 }
 
 /// Read a GNSS position log of any format (the module doc; `opts.format`, or told by

@@ -38,6 +38,40 @@ pub fn read_lines_whole(path: &Path) -> Result<Vec<u8>, InputError> {
     }
 }
 
+/// Every data line of the text file `path`, read one at a time into a reused buffer
+/// (memory bounded by the longest line, not the file): trimmed, with its 1-based
+/// number, blank lines and comments left out, as [`data_lines`] gives them from
+/// the whole text ([`read_lines_whole`]; a second byte-order mark dropped as
+/// `gnss::utf8_text` drops it). A line that is not UTF-8 is an error naming it.
+pub(crate) fn for_each_data_line(
+    path: &Path,
+    mut f: impl FnMut(u64, &str) -> Result<(), InputError>,
+) -> Result<(), InputError> {
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(path, &e))?;
+    let mut r = LineReader::new(std::io::BufReader::with_capacity(1 << 16, file));
+    loop {
+        match r.next_line() {
+            Ok(false) => return Ok(()),
+            Ok(true) => {
+                let n = r.line_no();
+                let bytes = match r.line() {
+                    l if n == 1 => l.strip_prefix(BOM).unwrap_or(l),
+                    l => l,
+                };
+                let l = std::str::from_utf8(bytes).map_err(|_| {
+                    InputError::new(InputErrorKind::NotANumber, path, n, None, "not UTF-8 text")
+                })?;
+                let l = l.trim();
+                if !is_skippable(l.as_bytes()) {
+                    f(n, l)?;
+                }
+            }
+            Err(LineReadError::Io(e)) => return Err(cannot_read(path, &e)),
+            Err(LineReadError::TooLong) => return Err(too_long(path, r.line_no())),
+        }
+    }
+}
+
 /// A configuration file's text, at most [`MAX_CONFIG_BYTES`], without a leading
 /// byte-order mark.
 pub fn read_config_text(path: &Path) -> Result<String, InputError> {
@@ -72,7 +106,7 @@ pub fn read_config_text(path: &Path) -> Result<String, InputError> {
     })
 }
 
-fn cannot_read(path: &Path, e: &std::io::Error) -> InputError {
+pub(crate) fn cannot_read(path: &Path, e: &std::io::Error) -> InputError {
     InputError::new(
         InputErrorKind::Io,
         path,
