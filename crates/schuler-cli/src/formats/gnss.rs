@@ -612,11 +612,12 @@ fn outlier_flag(path: &Path, n: u64, x: Option<f64>) -> Result<Option<bool>, Inp
     }
 }
 
+/// A CSV position log's columns to read (place, name) and its outlier column's place.
+type PositionCols = (Vec<(usize, &'static str)>, Option<usize>);
+
 /// The columns a CSV position log's header `h` gives (time, position, and the
 /// standard deviations if any), and the place of its outlier column if it has one.
-fn csv_position_cols(
-    h: &CsvHeader,
-) -> Result<(Vec<(usize, &'static str)>, Option<usize>), InputError> {
+fn csv_position_cols(h: &CsvHeader) -> Result<PositionCols, InputError> {
     let mut cols: Vec<(usize, &str)> = h
         .require(&CSV_POS, "a GNSS position log", "")?
         .into_iter()
@@ -736,13 +737,13 @@ pub fn for_each_text_record(
     default_std: Option<Vector3<f64>>,
     mut sink: impl FnMut(GnssRecord),
 ) -> Result<(), InputError> {
-    type Csv<'a> = (CsvHeader<'a>, Vec<(usize, &'static str)>, Option<usize>);
+    type Csv<'a> = (CsvHeader<'a>, PositionCols);
     let (mut first, mut csv, mut prev): (bool, Option<Csv>, Option<f64>) = (true, None, None);
     super::lines::for_each_data_line(path, |n, l| {
         if std::mem::take(&mut first) && is_header(l) {
             let h = CsvHeader::parse(path, n, l);
-            let (cols, outlier) = csv_position_cols(&h)?;
-            csv = Some((h, cols, outlier));
+            let cols = csv_position_cols(&h)?;
+            csv = Some((h, cols));
             return Ok(());
         }
         // `t lat lon h [std_n std_e std_d [vn ve vd std_vn std_ve std_vd]]`, the
@@ -754,7 +755,7 @@ pub fn for_each_text_record(
                 })?;
                 (v, None, (POS_FIELDS[0], (["lat", "lon", "h"], "std_n")))
             }
-            Some((h, cols, outlier)) => {
+            Some((h, (cols, outlier))) => {
                 let mut v = h.row(n, l, cols, "")?;
                 let flag = outlier_flag(path, n, outlier.and_then(|_| v.pop()))?;
                 let names = (["lat_deg", "lon_deg", "h_m"], "std_n_m");
