@@ -84,10 +84,9 @@ pub(crate) fn given_readings(
 
 /// Navigates as `schuler nav` with `flags`: the IMU samples from `imu` (columns) or the
 /// file of `--imu`, aids from `gnss`/`baro`/`rest`/`odometer`/`heading` columns or
-/// their files. Returns the tables
-/// (see [`Tables::take_dict`]), `smoothed` (with `--smooth`), `summary` and how the
-/// run started (`alignment` with `--align`, `start_in_motion` with `--init gnss`).
-/// The GIL is released while it runs.
+/// their files. Returns the tables (see [`Tables::take_dict`]), `smoothed` (with
+/// `--smooth`), `summary` and how the run started (`alignment` with `--align`,
+/// `start_in_motion` with `--init gnss`). The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (flags, imu=None, imu_dt=None, gnss=None, baro=None, rest=None, odometer=None, heading=None))]
 #[allow(clippy::too_many_arguments)] // one keyword argument per input, as Python passes them
