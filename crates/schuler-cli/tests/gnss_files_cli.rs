@@ -180,18 +180,25 @@ fn the_simulators_csv_navigates_as_its_text_twin() {
 #[test]
 fn a_position_log_as_the_velocity_log_names_file_and_line() {
     let dir = tempfile::tempdir().expect("tempdir");
-    // Ten seconds at rest, no velocity noise in the scenario: gnss.csv's velocity
-    // standard deviations are 0.
+    // Ten seconds at rest, no velocity_std in the scenario: the receiver measures no
+    // velocity, and gnss.csv has no velocity columns (the simulator once wrote the
+    // true velocity with standard deviations of 0).
     let body = "seed = 3\n[start]\nposition = [\"30.5 deg\", \"114.3 deg\", \"50 m\"]\n\
                 attitude = [\"0 deg\", \"0 deg\", \"30 deg\"]\n[[motion]]\ntype = \"hold\"\n\
                 duration = \"10 s\"\n[imu]\nrate_hz = 100\npreset = \"tactical\"\n[gnss]\n\
                 rate_hz = 1\nposition_std = [\"0.5 m\", \"0.5 m\", \"1 m\"]\n";
     let sim = simulate(dir.path(), "rest", body);
     let (txt, csv) = (sim.join("gnss.txt"), sim.join("gnss.csv"));
+    let text = std::fs::read_to_string(&csv).expect("csv");
+    assert_eq!(
+        text.lines().next(),
+        Some("t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,outlier")
+    );
+    assert!(text.lines().skip(1).all(|l| l.split(',').count() == 8));
     let out = dir.path().join("out");
-    // The CSV still gives its positions (its zero velocity stds are not read)...
+    // The CSV gives its positions...
     nav(&sim, &out, &["--gnss".as_ref(), csv.as_os_str()]).success();
-    // ... but as velocities they cannot be weighed.
+    // ... and, named as the velocity log, its header says it has none.
     nav(
         &sim,
         &out,
@@ -204,8 +211,27 @@ fn a_position_log_as_the_velocity_log_names_file_and_line() {
     )
     .failure()
     .stderr(predicate::str::contains(format!(
-        "{}:2: field std_vn_mps: a standard deviation must be positive, got 0",
+        "{}:1: the header lacks columns vn_mps, ve_mps, vd_mps",
         csv.display()
+    )));
+    // A perfect velocity sensor (velocity_std 0, written as such) cannot be weighed.
+    let perfect = body.to_owned() + "velocity_std = [\"0 m/s\", \"0 m/s\", \"0 m/s\"]\n";
+    let sim0 = simulate(dir.path(), "perfect", &perfect);
+    let csv0 = sim0.join("gnss.csv");
+    nav(
+        &sim0,
+        &out,
+        &[
+            "--gnss".as_ref(),
+            sim0.join("gnss.txt").as_os_str(),
+            "--gnss-vel".as_ref(),
+            csv0.as_os_str(),
+        ],
+    )
+    .failure()
+    .stderr(predicate::str::contains(format!(
+        "{}:2: field std_vn_mps: a standard deviation must be positive, got 0",
+        csv0.display()
     )));
     // gnss.txt as the velocity log: its first fix repeats itself.
     nav(

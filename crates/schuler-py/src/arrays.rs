@@ -10,6 +10,7 @@ use schuler::filter::GnssFix;
 use schuler::imu::ImuSample;
 use schuler_cli::formats::InputError;
 use schuler_cli::formats::error::InputErrorKind;
+use schuler_cli::formats::vehicle::Rows;
 use std::path::Path;
 
 /// Name of the IMU arrays in errors.
@@ -183,6 +184,54 @@ pub fn gnss_fixes(cols: &[ArrayView1<'_, f64>]) -> Result<Vec<GnssFix>, InputErr
         });
     }
     Ok(fixes)
+}
+
+/// Numbered rows of `cols` named `names` (as many columns as one of `counts`, of equal
+/// lengths, every value finite, the first column's times increasing), row `i` as line
+/// `i + 1`: the rows a log's file reader gives ([`schuler_cli::formats::vehicle::Rows`]).
+pub fn rows(
+    what: &str,
+    names: &[&str],
+    counts: &[usize],
+    cols: &[ArrayView1<'_, f64>],
+) -> Result<Rows, InputError> {
+    if !counts.contains(&cols.len()) {
+        let counts: Vec<String> = counts.iter().map(usize::to_string).collect();
+        let msg = format!(
+            "{} columns ({}), got {}",
+            counts.join(" or "),
+            names.join(", "),
+            cols.len()
+        );
+        return Err(err(InputErrorKind::ColumnCount, what, 0, "columns", msg));
+    }
+    let n = cols.first().map_or(0, |c| c.len());
+    for (name, c) in names.iter().zip(cols) {
+        if c.len() != n {
+            let msg = format!("{} values where the first column has {n}", c.len());
+            return Err(err(InputErrorKind::ColumnCount, what, 0, name, msg));
+        }
+    }
+    let mut out: Rows = Vec::with_capacity(n);
+    for i in 0..n {
+        let v = (0..cols.len())
+            .map(|k| finite(what, i, names[k], cols[k][i]))
+            .collect::<Result<Vec<f64>, _>>()?;
+        if let Some((_, prev)) = out.last()
+            && v[0] <= prev[0]
+        {
+            let msg = format!("time {} does not increase (previous {})", v[0], prev[0]);
+            return Err(err(
+                InputErrorKind::TimeNotIncreasing,
+                what,
+                i,
+                names[0],
+                msg,
+            ));
+        }
+        out.push((i as u64 + 1, v));
+    }
+    Ok(out)
 }
 
 /// Barometer readings `(t, h)` from columns time [s] and height [m].

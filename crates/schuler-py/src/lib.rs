@@ -16,6 +16,7 @@ mod readers;
 mod run;
 mod session;
 mod simulate;
+mod vehicle;
 
 use arrays::ImuArrays;
 use errors::IntoPy;
@@ -45,10 +46,22 @@ pub(crate) fn imu_views<'a>(
     })
 }
 
-/// The aiding readings given as arrays.
+/// Columns given by Python, read in place.
+type ColumnsIn<'py> = Option<Vec<PyReadonlyArray1<'py, f64>>>;
+
+/// Views of `cols`.
+fn views<'a>(cols: &'a ColumnsIn<'_>) -> Option<Vec<numpy::ndarray::ArrayView1<'a, f64>>> {
+    cols.as_ref()
+        .map(|c| c.iter().map(|x| x.as_array()).collect())
+}
+
+/// The aiding readings given as arrays: `gnss` and `baro` columns, and the vehicle
+/// aids' `[rest, odometer, heading]` columns ([`vehicle::REST`],
+/// [`vehicle::ODOMETER`], [`vehicle::HEADING`]).
 pub(crate) fn given_readings(
     gnss: Option<Vec<PyReadonlyArray1<'_, f64>>>,
     baro: Option<(PyReadonlyArray1<'_, f64>, PyReadonlyArray1<'_, f64>)>,
+    [rest, odometer, heading]: [&ColumnsIn<'_>; 3],
 ) -> anyhow::Result<GivenReadings> {
     let fixes = match gnss {
         Some(g) => Some(arrays::gnss_fixes(
@@ -60,16 +73,23 @@ pub(crate) fn given_readings(
         Some((t, h)) => Some(arrays::baro_readings(t.as_array(), h.as_array())?),
         None => None,
     };
-    Ok(GivenReadings { fixes, baro })
+    let (rest, odometer, heading) = (views(rest), views(odometer), views(heading));
+    let vehicle = vehicle::given(rest.as_deref(), odometer.as_deref(), heading.as_deref())?;
+    Ok(GivenReadings {
+        fixes,
+        baro,
+        vehicle,
+    })
 }
 
 /// Navigates as `schuler nav` with `flags`: the IMU samples from `imu` (columns) or the
-/// file of `--imu`, aids from `gnss`/`baro` columns or their files. Returns the tables
-/// (see [`Tables::take_dict`]), `smoothed` (with `--smooth`), `summary` and how the
-/// run started (`alignment` with `--align`, `start_in_motion` with `--init gnss`).
-/// The GIL is released while it runs.
+/// file of `--imu`, aids from `gnss`/`baro`/`rest`/`odometer`/`heading` columns or
+/// their files. Returns the tables (see [`Tables::take_dict`]), `smoothed` (with
+/// `--smooth`), `summary` and how the run started (`alignment` with `--align`,
+/// `start_in_motion` with `--init gnss`). The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (flags, imu=None, imu_dt=None, gnss=None, baro=None))]
+#[pyo3(signature = (flags, imu=None, imu_dt=None, gnss=None, baro=None, rest=None, odometer=None, heading=None))]
+#[allow(clippy::too_many_arguments)] // one keyword argument per input, as Python passes them
 fn navigate<'py>(
     py: Python<'py>,
     flags: Vec<String>,
@@ -77,8 +97,11 @@ fn navigate<'py>(
     imu_dt: Option<PyReadonlyArray1<'py, f64>>,
     gnss: Option<Vec<PyReadonlyArray1<'py, f64>>>,
     baro: Option<(PyReadonlyArray1<'py, f64>, PyReadonlyArray1<'py, f64>)>,
+    rest: ColumnsIn<'py>,
+    odometer: ColumnsIn<'py>,
+    heading: ColumnsIn<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut plan = given_readings(gnss, baro)
+    let mut plan = given_readings(gnss, baro, [&rest, &odometer, &heading])
         .and_then(|given| Plan::new(&flags, given))
         .py_err(py)?;
     let views = match &imu {

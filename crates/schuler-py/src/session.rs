@@ -4,6 +4,7 @@
 use crate::errors::IntoPy;
 use crate::errors::SchulerError;
 use crate::run::{AnySession, Plan, Tables, smoothed_columns, summary_dict};
+use crate::vehicle::{self, Source};
 use nalgebra::Vector3;
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
@@ -14,6 +15,7 @@ use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::{Aid, Finished};
 use schuler_cli::aided::GivenReadings;
+use schuler_cli::aided::vehicle::GivenVehicle;
 use schuler_cli::commands::nav::InitChoice;
 
 /// A navigation session fed by pushes; its tables are taken as they grow.
@@ -52,14 +54,28 @@ impl PySession {
 #[pymethods]
 impl PySession {
     /// A session configured by `schuler nav`'s `flags` (an `--imu` placeholder among
-    /// them; aids are pushed, not read); `gnss`, `baro`: such aids will be pushed (the
-    /// filter and its barometer state are set up for them).
+    /// them; aids are pushed, not read); `gnss`, `baro`, `rest`, `odometer`, `heading`:
+    /// such aids will be pushed (the filter is set up for them as for their files:
+    /// barometer bias, rest updates, odometer noise and scale factor, antenna baseline).
     #[new]
-    #[pyo3(signature = (flags, gnss=false, baro=false))]
-    fn new(py: Python<'_>, flags: Vec<String>, gnss: bool, baro: bool) -> PyResult<Self> {
+    #[pyo3(signature = (flags, gnss=false, baro=false, rest=false, odometer=false, heading=false))]
+    fn new(
+        py: Python<'_>,
+        flags: Vec<String>,
+        gnss: bool,
+        baro: bool,
+        rest: bool,
+        odometer: bool,
+        heading: bool,
+    ) -> PyResult<Self> {
         let given = GivenReadings {
             fixes: gnss.then(Vec::new),
             baro: baro.then(Vec::new),
+            vehicle: GivenVehicle {
+                rests: rest.then(Vec::new),
+                odometer: odometer.then(Vec::new),
+                headings: heading.then(Vec::new),
+            },
         };
         let plan = Plan::new(&flags, given).py_err(py)?;
         if plan.align.is_some() || plan.init != InitChoice::Given {
@@ -162,6 +178,51 @@ impl PySession {
         self.push_aid(py, Aid::Baro { t, h: h_m })
     }
 
+    /// Pushes that the vehicle was at rest from `t0_s` to `t1_s` [s] (zero-velocity
+    /// updates inside; `t1_s > t0_s`), checked as a line of `--zupt`'s file.
+    fn push_rest(&mut self, py: Python<'_>, t0_s: f64, t1_s: f64) -> PyResult<()> {
+        let r = vehicle::rests(&one_row(&[t0_s, t1_s]).views(), Source::Push).py_err(py)?;
+        self.push_aids(py, r.into_iter().map(|(t0, t1)| Aid::Rest { t0, t1 }))
+    }
+
+    /// Pushes an odometer reading: forward speed `speed_mps` [m/s] of the point at
+    /// `--vehicle-lever-arm` at time `t` [s], checked as a line of `--odometer`'s file.
+    fn push_odometer(&mut self, py: Python<'_>, t: f64, speed_mps: f64) -> PyResult<()> {
+        let r = vehicle::odometer(&one_row(&[t, speed_mps]).views(), Source::Push).py_err(py)?;
+        self.push_aids(
+            py,
+            r.into_iter().map(|(t, speed)| Aid::Odometer { t, speed }),
+        )
+    }
+
+    /// Pushes a dual-antenna reading at time `t` [s]: the baseline's heading from true
+    /// north, clockwise, and its standard deviation [deg], optionally its pitch and
+    /// standard deviation [deg] (both or neither), checked as a line of
+    /// `--dual-antenna`'s file.
+    #[pyo3(signature = (t, heading_deg, heading_std_deg, pitch_deg=None, pitch_std_deg=None))]
+    fn push_heading(
+        &mut self,
+        py: Python<'_>,
+        t: f64,
+        heading_deg: f64,
+        heading_std_deg: f64,
+        pitch_deg: Option<f64>,
+        pitch_std_deg: Option<f64>,
+    ) -> PyResult<()> {
+        let mut row = vec![t, heading_deg, heading_std_deg];
+        match (pitch_deg, pitch_std_deg) {
+            (Some(p), Some(s)) => row.extend([p, s]),
+            (None, None) => {}
+            _ => {
+                return Err(SchulerError::new_err(
+                    "push_heading: pitch_deg and pitch_std_deg go together",
+                ));
+            }
+        }
+        let r = vehicle::headings(&one_row(&row).views(), Source::Push).py_err(py)?;
+        self.push_aids(py, r.into_iter().map(Aid::Heading))
+    }
+
     /// The tables produced since the last `take` (dict of dicts of numpy arrays).
     fn take<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let (_, tables) = self.open().py_err(py)?;
@@ -183,11 +244,31 @@ impl PySession {
 
 impl PySession {
     fn push_aid(&mut self, py: Python<'_>, aid: Aid) -> PyResult<()> {
+        self.push_aids(py, std::iter::once(aid))
+    }
+
+    fn push_aids(&mut self, py: Python<'_>, aids: impl Iterator<Item = Aid>) -> PyResult<()> {
         let (session, tables) = self.open().py_err(py)?;
-        session.push(aid).py_err(py)?;
+        for aid in aids {
+            session.push(aid).py_err(py)?;
+        }
         session.take(tables);
         Ok(())
     }
+}
+
+/// One row of values as one-element columns.
+struct OneRow(Vec<numpy::ndarray::Array1<f64>>);
+
+impl OneRow {
+    fn views(&self) -> Vec<numpy::ndarray::ArrayView1<'_, f64>> {
+        self.0.iter().map(|c| c.view()).collect()
+    }
+}
+
+/// `values` as a table of one row.
+fn one_row(values: &[f64]) -> OneRow {
+    OneRow(values.iter().map(|&x| numpy::ndarray::arr1(&[x])).collect())
 }
 
 /// Adds `smoothed` (or None) and `summary` of a finished session to `d`.

@@ -127,7 +127,7 @@ pub fn simulate_scenario<'py>(
         gnss: Columns::joined(&[GNSS, &["outlier"]]),
         baro: Columns::new(&["t_s", "h_m", "outlier"]),
         sensor_errors: Columns::new(crate::columns::SENSOR),
-        gnss_velocity: spec.gnss.as_ref().is_some_and(|g| g.velocity_std.is_some()),
+        gnss_velocity: schuler_cli::commands::simulate::simulates_gnss_velocity(&spec),
     };
     py.detach(|| simulate(&spec, &mut c)).py_err(py)?;
     let d = PyDict::new(py);

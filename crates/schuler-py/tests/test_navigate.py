@@ -101,6 +101,27 @@ def test_against_the_truth(drive):
     assert 0.5 < r.summary["mean_nis_per_dof"] < 2.0
 
 
+def push_gnss(s, gnss):
+    """Pushes the fixes of a `read_gnss` table (positions) into session `s`."""
+    for row in gnss.itertuples():
+        s.push_gnss(row.t_s, row.lat_deg, row.lon_deg, row.h_m, (row.std_n_m, row.std_e_m, row.std_d_m))
+
+
+def push_imu_and_finish(s, imu, singly=1000):
+    """Pushes the `read_imu` table `imu` into session `s`, its first `singly` samples
+    one by one (the first with its interval), the rest as one block, taking the tables
+    in between, and finishes it: the trajectory and the standard deviations of both
+    takes joined, and the finished result."""
+    head, tail = imu.iloc[:singly], imu.iloc[singly:]
+    for row in head.itertuples():
+        s.push_imu(row.t_s, (row.dtheta_x_rad, row.dtheta_y_rad, row.dtheta_z_rad), (row.dvel_x_mps, row.dvel_y_mps, row.dvel_z_mps), dt=row.dt_s if row.Index == 0 else None)
+    first = s.take()
+    s.push_imu_block(tail.drop(columns="dt_s"))
+    rest = s.finish()
+    joined = [pd.concat([getattr(first, k), getattr(rest, k)], ignore_index=True) for k in ("trajectory", "std")]
+    return joined[0], joined[1], rest
+
+
 def test_session_pushes_equal_navigate(drive):
     kw = dict(output_rate=10, end=300.0, **START)
     imu = schuler.read_imu(drive / "imu.txt", end=300.0)
@@ -108,15 +129,8 @@ def test_session_pushes_equal_navigate(drive):
     gnss = gnss[gnss["t_s"] <= 300.0]
     ref = schuler.navigate(imu, gnss=gnss, **kw)
     s = schuler.Session(gnss=True, **kw)
-    for row in gnss.itertuples():
-        s.push_gnss(row.t_s, row.lat_deg, row.lon_deg, row.h_m, (row.std_n_m, row.std_e_m, row.std_d_m))
-    head, tail = imu.iloc[:1000], imu.iloc[1000:]
-    for row in head.itertuples():
-        s.push_imu(row.t_s, (row.dtheta_x_rad, row.dtheta_y_rad, row.dtheta_z_rad), (row.dvel_x_mps, row.dvel_y_mps, row.dvel_z_mps), dt=row.dt_s if row.Index == 0 else None)
-    first = s.take()
-    s.push_imu_block(tail.drop(columns="dt_s"))
-    rest = s.finish()
-    traj = pd.concat([first.trajectory, rest.trajectory], ignore_index=True)
+    push_gnss(s, gnss)
+    traj, _, rest = push_imu_and_finish(s, imu)
     pd.testing.assert_frame_equal(traj, ref.trajectory, check_exact=True)
     assert rest.summary == ref.summary
     with pytest.raises(schuler.SchulerError, match="finished"):

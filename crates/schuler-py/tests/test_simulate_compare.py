@@ -96,3 +96,22 @@ def test_fixes_without_simulated_velocity_have_none(sim):
     r = schuler.navigate(no_vel.imu, gnss=no_vel.gnss, output_rate=1, end=300.0, **START)
     c = r.summary["counts"]
     assert c["gnss_position"] > 200 and c["gnss_velocity"] == 0
+
+
+def test_gnss_without_velocity_std_has_no_velocity(cli, tmp_path):
+    """A receiver simulated without `velocity_std` measures no velocity: `gnss.csv`
+    has no velocity columns and the Python table NaN velocities (so both aid by
+    position only); the positions are the same numbers."""
+    text = (
+        'seed = 3\n[start]\nposition = ["30.5 deg", "114.3 deg", "50 m"]\n'
+        'attitude = ["0 deg", "0 deg", "30 deg"]\n[[motion]]\ntype = "hold"\nduration = "10 s"\n'
+        '[imu]\nrate_hz = 100\npreset = "tactical"\n'
+        '[gnss]\nrate_hz = 1\nposition_std = ["0.5 m", "0.5 m", "1 m"]\n'
+    )
+    (tmp_path / "s.toml").write_text(text)
+    cli("simulate", "--config", tmp_path / "s.toml", "--out", tmp_path / "out")
+    csv = pd.read_csv(tmp_path / "out" / "gnss.csv")
+    assert list(csv.columns) == ["t", "lat_deg", "lon_deg", "h_m", "std_n_m", "std_e_m", "std_d_m", "outlier"]
+    sim = schuler.simulate(text)
+    assert sim.gnss[list(schuler.GNSS_VELOCITY)].isna().all().all()
+    np.testing.assert_array_equal(sim.gnss[["t_s", "lat_deg", "lon_deg", "h_m"]].to_numpy(), csv[["t", "lat_deg", "lon_deg", "h_m"]].to_numpy())

@@ -88,19 +88,22 @@ pub struct Aiding {
     pub vehicle: VehicleReadings,
 }
 
-/// Aiding readings held in memory, in place of the files of `--gnss` and `--baro`.
+/// Aiding readings held in memory, in place of the files of `--gnss`, `--baro` and the
+/// vehicle aids.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct GivenReadings {
     /// GNSS fixes in time order.
     pub fixes: Option<Vec<GnssFix>>,
     /// Barometer readings `(t, h)` [s, m].
     pub baro: Option<Vec<(f64, f64)>>,
+    /// Rest intervals, odometer and heading readings.
+    pub vehicle: vehicle::GivenVehicle,
 }
 
 impl GivenReadings {
     /// Whether any readings are given.
     pub fn any(&self) -> bool {
-        self.fixes.is_some() || self.baro.is_some()
+        self.fixes.is_some() || self.baro.is_some() || self.vehicle.any()
     }
 }
 
@@ -464,7 +467,7 @@ impl AidingOptions {
         if !has_gnss && self.gnss_vel.is_some() {
             bail!("--gnss-vel needs --gnss (velocities are matched to position fixes)");
         }
-        vehicle::check_dependencies(self)?;
+        vehicle::check_dependencies(self, &given.vehicle)?;
         if !(self.any() || given.any()) {
             // The truth serves the filter's report and outage test: a free-inertial
             // run has neither, so it is refused rather than ignored.
@@ -486,7 +489,7 @@ impl AidingOptions {
         let (fixes, outage_test) = self.fix_store(given.fixes)?;
         let noise = self.noise(noise)?;
         let (baro, baro_std) = self.baro(given.baro)?;
-        let (vehicle_cfg, vehicle) = vehicle::resolve(self, &noise)?;
+        let (vehicle_cfg, vehicle) = vehicle::resolve(self, &noise, given.vehicle)?;
         let mut integration = self.integration(noise)?;
         integration.baro = baro_std.map(|(_, bias)| (bias, 0.0));
         let error_model = self.error_model(&mut integration)?;

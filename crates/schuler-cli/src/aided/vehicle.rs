@@ -2,9 +2,9 @@
 //! rest from a file of rest intervals or detected from the IMU, optionally with
 //! zero-angular-rate updates; the non-holonomic constraint; odometer speed with an
 //! optional scale-factor state; dual-antenna GNSS heading. [`resolve`] checks the
-//! options and loads the files into the session's [`VehicleConfig`] and the readings
-//! the run pushes as aids; the library's session applies them
-//! ([`schuler::session`]).
+//! options and loads the files (or takes the readings a caller holds in memory,
+//! [`GivenVehicle`]) into the session's [`VehicleConfig`] and the readings the run
+//! pushes as aids; the library's session applies them ([`schuler::session`]).
 
 use super::AidingOptions;
 use crate::options::quantity;
@@ -41,19 +41,43 @@ impl VehicleReadings {
     }
 }
 
-/// Refuse options given without the aid they tune (e.g. `--nhc-std` without `--nhc`).
-pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
+/// Vehicle readings held in memory in place of the files of `--zupt`, `--odometer`
+/// and `--dual-antenna` (the Python package's arrays and pushes). `Some`, even empty,
+/// sets the aid up as its file would; the options that tune it act alike.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GivenVehicle {
+    /// Rest intervals `[t0, t1]` [s], in place of `--zupt FILE`.
+    pub rests: Option<Vec<(f64, f64)>>,
+    /// Odometer readings `(t, speed)` [s, m/s], in place of `--odometer FILE`.
+    pub odometer: Option<Vec<(f64, f64)>>,
+    /// Dual-antenna headings, in place of `--dual-antenna FILE`.
+    pub headings: Option<Vec<HeadingReading>>,
+}
+
+impl GivenVehicle {
+    /// Whether any readings are given.
+    pub fn any(&self) -> bool {
+        self.rests.is_some() || self.odometer.is_some() || self.headings.is_some()
+    }
+}
+
+/// Refuse options given without the aid they tune (e.g. `--nhc-std` without `--nhc`);
+/// `given`: readings in memory standing for their files.
+pub fn check_dependencies(o: &AidingOptions, given: &GivenVehicle) -> Result<()> {
+    let rests = o.zupt.is_some() || given.rests.is_some();
+    let odometer = o.has_odometer() || given.odometer.is_some();
+    let dual_antenna = o.dual_antenna.is_some() || given.headings.is_some();
     for (given, flag, needs, main) in [
         (
             o.zupt_std.is_some(),
             "zupt-std",
-            o.zupt.is_some() || o.zupt_detect,
+            rests || o.zupt_detect,
             "--zupt or --zupt-detect",
         ),
         (
             o.zupt_interval.is_some(),
             "zupt-interval",
-            o.zupt.is_some() || o.zupt_detect,
+            rests || o.zupt_detect,
             "--zupt or --zupt-detect",
         ),
         (
@@ -65,7 +89,7 @@ pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
         (
             o.zaru,
             "zaru",
-            o.zupt.is_some() || o.zupt_detect,
+            rests || o.zupt_detect,
             "--zupt or --zupt-detect",
         ),
         (o.zaru_std.is_some(), "zaru-std", o.zaru, "--zaru"),
@@ -74,31 +98,31 @@ pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
         (
             o.odometer_std.is_some(),
             "odometer-std",
-            o.has_odometer(),
+            odometer,
             "--odometer",
         ),
         (
             o.odometer_scale_std.is_some(),
             "odometer-scale-std",
-            o.has_odometer(),
+            odometer,
             "--odometer",
         ),
         (
             o.estimate_mounting.is_some(),
             "estimate-mounting",
-            o.nhc || o.has_odometer(),
+            o.nhc || odometer,
             "--nhc or --odometer",
         ),
         (
             o.dual_antenna_baseline_yaw.is_some(),
             "dual-antenna-baseline-yaw",
-            o.dual_antenna.is_some(),
+            dual_antenna,
             "--dual-antenna",
         ),
         (
             o.dual_antenna_baseline_pitch.is_some(),
             "dual-antenna-baseline-pitch",
-            o.dual_antenna.is_some(),
+            dual_antenna,
             "--dual-antenna",
         ),
     ] {
@@ -106,8 +130,8 @@ pub fn check_dependencies(o: &AidingOptions) -> Result<()> {
             bail!("--{flag} needs {main}");
         }
     }
-    if o.zupt.is_some() && o.zupt_detect {
-        bail!("--zupt FILE and --zupt-detect exclude each other");
+    if rests && o.zupt_detect {
+        bail!("--zupt FILE (or given rest intervals) and --zupt-detect exclude each other");
     }
     Ok(())
 }
@@ -122,21 +146,26 @@ fn positive(flag: &str, v: &Option<String>, dim: Dimension, default: f64) -> Res
     Ok(x)
 }
 
-/// Zero-velocity updates (`--zupt FILE`, its intervals read into `rests`, or
-/// `--zupt-detect`) with their noise, interval and optional zero-rate updates; `None`
-/// without either.
+/// Zero-velocity updates (`given` intervals or those of `--zupt FILE`, put into
+/// `rests`, or `--zupt-detect`) with their noise, interval and optional zero-rate
+/// updates; `None` without either.
 fn rest_config(
     o: &AidingOptions,
     noise: &ImuNoise,
+    given: Option<Vec<(f64, f64)>>,
     rests: &mut Vec<(f64, f64)>,
 ) -> Result<Option<RestConfig>> {
     let interval = positive("zupt-interval", &o.zupt_interval, Dimension::Time, 0.1)?;
-    let source = match (&o.zupt, o.zupt_detect) {
-        (Some(path), _) => {
+    let source = match (given, &o.zupt, o.zupt_detect) {
+        (Some(given), _, _) => {
+            *rests = given;
+            RestSource::Intervals
+        }
+        (None, Some(path), _) => {
             *rests = crate::formats::vehicle::read_rest_intervals(path)?;
             RestSource::Intervals
         }
-        (None, true) => RestSource::Detect {
+        (None, None, true) => RestSource::Detect {
             noise: *noise,
             max_speed: positive(
                 "zupt-max-speed",
@@ -145,7 +174,7 @@ fn rest_config(
                 0.5,
             )?,
         },
-        (None, false) => return Ok(None),
+        (None, None, false) => return Ok(None),
     };
     let std = positive("zupt-std", &o.zupt_std, Dimension::Velocity, 0.02)?;
     let zaru_std = if o.zaru {
@@ -168,10 +197,11 @@ fn rest_config(
     }))
 }
 
-/// The odometer's speed noise (`--odometer FILE`, its readings read into `readings`)
-/// and its scale-factor prior (`--odometer-scale-std`).
+/// The odometer's speed noise (`given` readings, those of `--odometer FILE` or the
+/// bag's, put into `readings`) and its scale-factor prior (`--odometer-scale-std`).
 fn odometer(
     o: &AidingOptions,
+    given: Option<Vec<(f64, f64)>>,
     readings: &mut Vec<(f64, f64)>,
 ) -> Result<(Option<f64>, Option<f64>)> {
     let from_bag = o
@@ -179,12 +209,13 @@ fn odometer(
         .as_ref()
         .map(|b| &b.odometer)
         .filter(|v| !v.is_empty());
-    let odometer_std = match (&o.odometer, from_bag) {
-        (None, None) => None,
-        (path, bag) => {
-            *readings = match (path, bag) {
-                (Some(path), _) => crate::formats::vehicle::read_odometer(path)?,
-                (None, bag) => bag.cloned().unwrap_or_default(),
+    let odometer_std = match (given, &o.odometer, from_bag) {
+        (None, None, None) => None,
+        (given, path, bag) => {
+            *readings = match (given, path, bag) {
+                (Some(given), _, _) => given,
+                (None, Some(path), _) => crate::formats::vehicle::read_odometer(path)?,
+                (None, None, bag) => bag.cloned().unwrap_or_default(),
             };
             Some(positive(
                 "odometer-std",
@@ -216,15 +247,17 @@ fn finite_degrees(flag: &str, v: Option<f64>) -> Result<f64> {
     Ok(x.to_radians())
 }
 
-/// The dual-antenna baseline (`--dual-antenna FILE`, its headings read into
-/// `headings`): yaw and pitch from the IMU's front, not within 1° of the vertical.
+/// The dual-antenna baseline (with `given` headings or those of `--dual-antenna
+/// FILE`, put into `headings`): yaw and pitch from the IMU's front, not within 1° of
+/// the vertical.
 fn heading_baseline(
     o: &AidingOptions,
+    given: Option<Vec<HeadingReading>>,
     headings: &mut Vec<HeadingReading>,
 ) -> Result<Option<Baseline>> {
-    let Some(path) = &o.dual_antenna else {
+    if given.is_none() && o.dual_antenna.is_none() {
         return Ok(None);
-    };
+    }
     let baseline = Baseline {
         yaw: finite_degrees("dual-antenna-baseline-yaw", o.dual_antenna_baseline_yaw)?,
         pitch: finite_degrees("dual-antenna-baseline-pitch", o.dual_antenna_baseline_pitch)?,
@@ -232,7 +265,11 @@ fn heading_baseline(
     if baseline.pitch.abs() >= 89f64.to_radians() {
         bail!("--dual-antenna-baseline-pitch: a baseline within 1° of the vertical has no heading");
     }
-    *headings = crate::formats::vehicle::read_heading(path)?;
+    *headings = match (given, &o.dual_antenna) {
+        (Some(given), _) => given,
+        (None, Some(path)) => crate::formats::vehicle::read_heading(path)?,
+        (None, None) => Vec::new(),
+    };
     Ok(Some(baseline))
 }
 
@@ -256,11 +293,16 @@ fn mount(o: &AidingOptions) -> Result<VehicleMount> {
     ))
 }
 
-/// Check the vehicle options and load their files.
-pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, VehicleReadings)> {
-    check_dependencies(o)?;
+/// Check the vehicle options and load their files; `given` readings stand in for
+/// theirs.
+pub fn resolve(
+    o: &AidingOptions,
+    noise: &ImuNoise,
+    given: GivenVehicle,
+) -> Result<(VehicleConfig, VehicleReadings)> {
+    check_dependencies(o, &given)?;
     let mut readings = VehicleReadings::default();
-    let rest = rest_config(o, noise, &mut readings.rests)?;
+    let rest = rest_config(o, noise, given.rests, &mut readings.rests)?;
     let nhc = if o.nhc {
         Some((
             positive("nhc-std", &o.nhc_std, Dimension::Velocity, 0.1)?,
@@ -269,8 +311,8 @@ pub fn resolve(o: &AidingOptions, noise: &ImuNoise) -> Result<(VehicleConfig, Ve
     } else {
         None
     };
-    let (odometer_std, odometer_scale_std) = odometer(o, &mut readings.odometer)?;
-    let heading_baseline = heading_baseline(o, &mut readings.headings)?;
+    let (odometer_std, odometer_scale_std) = odometer(o, given.odometer, &mut readings.odometer)?;
+    let heading_baseline = heading_baseline(o, given.headings, &mut readings.headings)?;
     let mounting_std = match &o.estimate_mounting {
         None => None,
         Some(_) => Some(positive(
@@ -307,4 +349,67 @@ pub fn summary(c: &Counts) -> Option<String> {
     .map(|(n, what)| format!("{n} {what}"))
     .collect();
     (!parts.is_empty()).then(|| format!("vehicle updates: {}", parts.join(", ")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::temp_file;
+    use crate::options::GradeChoice;
+
+    /// Readings given in memory set the aids up as their files do: the same session
+    /// configuration and the same readings pushed.
+    #[test]
+    fn given_readings_stand_for_their_files() {
+        let noise = GradeChoice::Tactical.noise().expect("noise");
+        let (rest, odo, heading) = (
+            temp_file("0 60\n100.5 130\n"),
+            temp_file("t,speed\n60.1 0.5\n60.2 -0.25\n"),
+            temp_file("1 350 0.1\n2 10 0.2 -2 0.3\n"),
+        );
+        let tuning = AidingOptions {
+            zaru: true,
+            odometer_scale_std: Some("1 %".into()),
+            dual_antenna_baseline_yaw: Some(90.0),
+            ..Default::default()
+        };
+        let files = AidingOptions {
+            zupt: Some(rest.path().into()),
+            odometer: Some(odo.path().into()),
+            dual_antenna: Some(heading.path().into()),
+            ..tuning.clone()
+        };
+        let read = resolve(&files, &noise, GivenVehicle::default()).expect("files");
+        let v = crate::formats::vehicle::read_heading(heading.path()).expect("headings");
+        let given = GivenVehicle {
+            rests: Some(vec![(0.0, 60.0), (100.5, 130.0)]),
+            odometer: Some(vec![(60.1, 0.5), (60.2, -0.25)]),
+            headings: Some(v),
+        };
+        assert_eq!(
+            resolve(&tuning, &noise, given.clone()).expect("given"),
+            read
+        );
+        // Given readings win over a file, as given GNSS fixes do.
+        let mut one = given.clone();
+        one.odometer = Some(vec![(1.0, 2.0)]);
+        let (_, r) = resolve(&files, &noise, one).expect("given over files");
+        assert_eq!(r.odometer, vec![(1.0, 2.0)]);
+        // Their options need them, and rests exclude the detector.
+        let lone = AidingOptions {
+            odometer_std: Some("0.05 m/s".into()),
+            ..Default::default()
+        };
+        let e = resolve(&lone, &noise, GivenVehicle::default()).expect_err("no odometer");
+        assert!(
+            e.to_string().contains("--odometer-std needs --odometer"),
+            "{e}"
+        );
+        let detect = AidingOptions {
+            zupt_detect: true,
+            ..Default::default()
+        };
+        let e = resolve(&detect, &noise, given).expect_err("both");
+        assert!(e.to_string().contains("exclude each other"), "{e}");
+    }
 }

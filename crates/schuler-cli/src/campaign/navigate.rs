@@ -94,7 +94,11 @@ fn given(data: &Recorded, streams: Streams, with_gnss: bool, with_baro: bool) ->
             .collect()
     });
     let baro = (streams.baro && with_baro).then(|| data.baro.clone());
-    GivenReadings { fixes, baro }
+    GivenReadings {
+        fixes,
+        baro,
+        ..Default::default()
+    }
 }
 
 /// Navigates `data` with the campaign's options, from the truth at its first sample.

@@ -16,7 +16,9 @@
 //!   millimetre after 30 min) and far below the biases of a navigation-grade IMU
 //!   (0.01 deg/h, 50 µg);
 //! - `gnss.txt` (KF-GINS: `t lat lon h std_n std_e std_d`) and `gnss.csv` (adds the
-//!   velocity and its std and the outlier flag);
+//!   velocity and its std when the scenario measures it, `gnss.velocity_std`, and the
+//!   outlier flag: a receiver simulated without it reports no velocity, rather than
+//!   the true one with a standard deviation of 0, which no reader can weigh);
 //! - `baro.csv` (`t,h_m,outlier`);
 //! - `imu_err_truth.txt`: the true IMU errors once a second in the layout of `schuler
 //!   nav`'s `imu_err.txt` (`t`, gyro bias [deg/h], accelerometer bias [mGal], gyro and
@@ -219,9 +221,26 @@ fn push_shortest_line(out: &mut Vec<u8>, xs: &[f64], sep: u8) {
     out.push(b'\n');
 }
 
-/// `gnss.txt` (`t lat lon h std_n std_e std_d`) and `gnss.csv` (the same, then the
-/// velocity, its std and the outlier flag) lines of a fix.
-fn gnss_lines(fix: &GnssFix, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
+/// Whether the scenario's receiver measures velocity (`gnss.velocity_std` given):
+/// without, its fixes' velocity is the truth with a standard deviation of 0, not a
+/// measurement, and `gnss.csv` has no velocity columns.
+pub fn simulates_gnss_velocity(spec: &ScenarioSpec) -> bool {
+    spec.gnss.as_ref().is_some_and(|g| g.velocity_std.is_some())
+}
+
+/// `gnss.csv`'s header (velocity columns with `velocity`).
+fn gnss_csv_header(velocity: bool) -> String {
+    let velocity = if velocity {
+        ",vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps"
+    } else {
+        ""
+    };
+    format!("t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m{velocity},outlier")
+}
+
+/// `gnss.txt` (`t lat lon h std_n std_e std_d`) and `gnss.csv` (the same, then with
+/// `velocity` the velocity and its std, then the outlier flag) lines of a fix.
+fn gnss_lines(fix: &GnssFix, velocity: bool, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
     let (p, sd, v, vsd) = (fix.pos, fix.pos_std, fix.v_n, fix.vel_std);
     let row = [
         fix.t,
@@ -240,7 +259,11 @@ fn gnss_lines(fix: &GnssFix, txt: &mut Vec<u8>, csv: &mut Vec<u8>) {
         f64::from(u8::from(fix.outlier)),
     ];
     push_shortest_line(txt, &row[..7], b' ');
-    push_shortest_line(csv, &row, b',');
+    if velocity {
+        push_shortest_line(csv, &row, b',');
+    } else {
+        push_shortest_line(csv, &[&row[..7], &row[13..]].concat(), b',');
+    }
 }
 
 /// The text of one block for every file (one per worker, its memory reused from block
@@ -261,8 +284,8 @@ struct BlockText {
 }
 
 impl BlockText {
-    /// The lines of `block` for every file.
-    fn format(&mut self, block: &SimBlock) {
+    /// The lines of `block` for every file (`gnss_velocity`: [`simulates_gnss_velocity`]).
+    fn format(&mut self, block: &SimBlock, gnss_velocity: bool) {
         for t in [
             &mut self.imu_txt,
             &mut self.imu_csv,
@@ -295,7 +318,7 @@ impl BlockText {
             &mut self.truth_csv,
         );
         for (_, fix) in &block.gnss {
-            gnss_lines(fix, &mut self.gnss_txt, &mut self.gnss_csv);
+            gnss_lines(fix, gnss_velocity, &mut self.gnss_txt, &mut self.gnss_csv);
         }
         for (_, r) in &block.baro {
             let row = [r.t, r.h, f64::from(u8::from(r.outlier))];
@@ -319,7 +342,9 @@ struct Files {
 }
 
 impl Files {
-    fn create(dir: &Path, gnss: bool, baro: bool) -> Result<Self> {
+    /// The files in `dir`; GNSS ones with `gnss` (`Some(velocity)`), `baro.csv` with
+    /// `baro`.
+    fn create(dir: &Path, gnss: Option<bool>, baro: bool) -> Result<Self> {
         let with_header = |name: &str, header: &str| -> Result<Out> {
             let mut o = Out::create(dir.join(name))?;
             o.append(format!("{header}\n").as_bytes())?;
@@ -336,16 +361,12 @@ impl Files {
                 "truth.csv",
                 "t,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg,w_x,w_y,w_z,f_x,f_y,f_z",
             )?,
-            gnss: if gnss {
-                Some((
+            gnss: match gnss {
+                Some(velocity) => Some((
                     Out::create(dir.join("gnss.txt"))?,
-                    with_header(
-                        "gnss.csv",
-                        "t,lat_deg,lon_deg,h_m,std_n_m,std_e_m,std_d_m,vn_mps,ve_mps,vd_mps,std_vn_mps,std_ve_mps,std_vd_mps,outlier",
-                    )?,
-                ))
-            } else {
-                None
+                    with_header("gnss.csv", &gnss_csv_header(velocity))?,
+                )),
+                None => None,
             },
             baro_csv: if baro {
                 Some(with_header("baro.csv", "t,h_m,outlier")?)
@@ -399,11 +420,13 @@ pub fn with_motion_csv(mut spec: ScenarioSpec, dir: &Path) -> Result<ScenarioSpe
 /// Simulate `spec` into `dir`; returns the summary.
 pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::run::SimSummary> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let mut files = Files::create(dir, spec.gnss.is_some(), spec.baro.is_some())?;
+    let velocity = simulates_gnss_velocity(spec);
+    let gnss = spec.gnss.is_some().then_some(velocity);
+    let mut files = Files::create(dir, gnss, spec.baro.is_some())?;
     let (mut samples, mut written_to) = (0u64, f64::NAN);
     let summary = simulate_with(
         spec,
-        |block, text: &mut BlockText| text.format(block),
+        |block, text: &mut BlockText| text.format(block, velocity),
         |text| {
             files.write(text)?;
             (samples, written_to) = (samples + text.samples, text.last_t);
@@ -625,7 +648,7 @@ mod tests {
                     imu: chunk.to_vec(),
                     ..SimBlock::default()
                 };
-                text.format(&block);
+                text.format(&block, true);
                 assert_same_text(&block, &text);
             }
         }
@@ -658,7 +681,7 @@ preset = "tactical"
         let summary = simulate_with(
             &spec,
             |block, text: &mut BlockText| {
-                text.format(block);
+                text.format(block, true);
                 assert_same_text(block, text);
             },
             |_| Ok(()),

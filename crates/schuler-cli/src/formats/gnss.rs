@@ -28,10 +28,12 @@
 //!     receiver's quality flag, and a navigator that dropped flagged fixes would be
 //!     handed the answer it is tested on; the filter's gate has to find them.
 //!   - the velocity columns (`vn_mps ve_mps vd_mps std_vn_mps std_ve_mps std_vd_mps`)
-//!     are not read as velocity aiding here: the simulator writes them whether or not
-//!     the scenario measures velocity (standard deviations 0, exact velocities, when it
-//!     sets no `gnss.velocity_std`), so a CSV's velocities are used only when the file
-//!     is also named as the velocity log (`--gnss-vel gnss.csv`, [`merge_velocity`]).
+//!     are not read as velocity aiding here: a CSV's velocities are used only when
+//!     the file is also named as the velocity log (`--gnss-vel gnss.csv`,
+//!     [`merge_velocity`]), so that it navigates as its `gnss.txt` twin. The
+//!     simulator writes them only when the scenario measures velocity
+//!     (`gnss.velocity_std`; it once wrote the exact velocity with standard deviations
+//!     of 0 without it).
 //!
 //!   So `gnss.csv` gives the same fixes as `gnss.txt` (the simulator writes the same
 //!   numbers in both), and the same navigation.

@@ -14,9 +14,31 @@ use schuler::domain;
 use schuler::filter::HeadingReading;
 use std::path::Path;
 
+/// Numbered rows `(line, values)` of a vehicle log: read from a file, or given in
+/// memory (the Python package's arrays, the row's 1-based index as its line), each
+/// value finite and the first column's times increasing.
+pub type Rows = Vec<(u64, Vec<f64>)>;
+
+/// Fields of a rest-interval line, as errors name them.
+pub const REST_FIELDS: [&str; 2] = ["t0", "t1"];
+/// Fields of an odometer line.
+pub const ODOMETER_FIELDS: [&str; 2] = ["time", "speed"];
+/// Fields of a dual-antenna line.
+pub const HEADING_FIELDS: [&str; 5] = ["time", "heading", "std_heading", "pitch", "std_pitch"];
+
 /// Read rest intervals `(t0, t1)`, each `t1 > t0` and `t0` after the previous `t1`.
 pub fn read_rest_intervals(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
-    let rows = numeric_rows(path, &["t0", "t1"], &[2], true)?;
+    let rows = numeric_rows(path, &REST_FIELDS, &[2], true)?;
+    rest_intervals(path, &REST_FIELDS, rows)
+}
+
+/// Rest intervals of `rows` (`t0 t1` [s]) of the log `path`, checked as
+/// [`read_rest_intervals`] checks them; errors name the fields `names`.
+pub fn rest_intervals(
+    path: &Path,
+    names: &[&str; 2],
+    rows: Rows,
+) -> Result<Vec<(f64, f64)>, InputError> {
     let mut out: Vec<(f64, f64)> = Vec::with_capacity(rows.len());
     for (n, v) in rows {
         let (t0, t1) = (v[0], v[1]);
@@ -25,7 +47,7 @@ pub fn read_rest_intervals(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
                 InputErrorKind::NotANumber,
                 path,
                 n,
-                Some("t1"),
+                Some(names[1]),
                 format!("the interval ends ({t1}) before it starts ({t0})"),
             ));
         }
@@ -36,7 +58,7 @@ pub fn read_rest_intervals(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
                 InputErrorKind::TimeNotIncreasing,
                 path,
                 n,
-                Some("t0"),
+                Some(names[0]),
                 format!("the interval starts ({t0}) inside the previous one (to {prev})"),
             ));
         }
@@ -47,16 +69,36 @@ pub fn read_rest_intervals(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
 
 /// Read odometer speeds `(t, speed)`.
 pub fn read_odometer(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
-    let rows = numeric_rows(path, &["time", "speed"], &[2], true)?;
+    let rows = numeric_rows(path, &ODOMETER_FIELDS, &[2], true)?;
+    odometer_readings(path, &ODOMETER_FIELDS, rows)
+}
+
+/// Odometer speeds of `rows` (`t speed` [s, m/s]) of the log `path`, each speed in
+/// its domain; errors name the fields `names`.
+pub fn odometer_readings(
+    path: &Path,
+    names: &[&str; 2],
+    rows: Rows,
+) -> Result<Vec<(f64, f64)>, InputError> {
     rows.into_iter()
-        .map(|(n, v)| Ok((v[0], in_domain(path, n, "speed", &domain::SPEED, v[1])?)))
+        .map(|(n, v)| Ok((v[0], in_domain(path, n, names[1], &domain::SPEED, v[1])?)))
         .collect()
 }
 
 /// Read dual-antenna headings (3 or 5 columns), angles converted to radians.
 pub fn read_heading(path: &Path) -> Result<Vec<HeadingReading>, InputError> {
-    let names = ["time", "heading", "std_heading", "pitch", "std_pitch"];
-    let rows = numeric_rows(path, &names, &[3, 5], true)?;
+    let rows = numeric_rows(path, &HEADING_FIELDS, &[3, 5], true)?;
+    heading_readings(path, &HEADING_FIELDS, rows)
+}
+
+/// Dual-antenna headings of `rows` (`t heading std [pitch pitch_std]` [s, deg]) of the
+/// log `path`: each angle in its domain, converted to radians, the heading wrapped into
+/// (-180°, 180°]; errors name the fields `names`.
+pub fn heading_readings(
+    path: &Path,
+    names: &[&str; 5],
+    rows: Rows,
+) -> Result<Vec<HeadingReading>, InputError> {
     rows.into_iter()
         .map(|(n, v)| {
             let angle = |k: usize, d: &domain::Domain| in_domain(path, n, names[k], d, v[k]);

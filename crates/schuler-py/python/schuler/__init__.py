@@ -78,6 +78,14 @@ IMU_INCREMENTS = (
 GNSS_POSITION = ("t_s", "lat_deg", "lon_deg", "h_m", "std_n_m", "std_e_m", "std_d_m")
 #: ... and velocity with its standard deviations (optional; NaN: none).
 GNSS_VELOCITY = ("vn_mps", "ve_mps", "vd_mps", "std_vn_mps", "std_ve_mps", "std_vd_mps")
+#: Rest intervals (``--zupt``'s ``t0 t1``): the vehicle still from ``t0_s`` to ``t1_s`` [s].
+REST_COLUMNS = ("t0_s", "t1_s")
+#: Odometer readings (``--odometer``'s ``t speed``): forward speed [m/s] at ``t_s``.
+ODOMETER_COLUMNS = ("t_s", "speed_mps")
+#: Dual-antenna headings (``--dual-antenna``'s ``t heading std``) [s, deg, deg] ...
+HEADING_COLUMNS = ("t_s", "heading_deg", "heading_std_deg")
+#: ... and optionally the baseline's pitch and its standard deviation [deg].
+HEADING_PITCH = ("pitch_deg", "pitch_std_deg")
 
 
 def _value(v: Any) -> str:
@@ -155,6 +163,27 @@ def _gnss(gnss: Table) -> List[np.ndarray]:
 def _baro(baro: Table):
     t, h = _columns(baro, ("t_s", "h_m"), "baro")
     return (t, h)
+
+
+def _heading(heading: Table) -> List[np.ndarray]:
+    """Heading columns, with the pitch's when the table has them (5 columns of an
+    array)."""
+    if isinstance(heading, np.ndarray):
+        names = HEADING_COLUMNS + (HEADING_PITCH if heading.ndim == 2 and heading.shape[1] >= 5 else ())
+    else:
+        given = [n in heading for n in HEADING_PITCH]
+        if any(given) and not all(given):
+            raise ValueError(f"heading: {' and '.join(HEADING_PITCH)} go together")
+        names = HEADING_COLUMNS + (HEADING_PITCH if all(given) else ())
+    return _columns(heading, names, "heading")
+
+
+#: The vehicle aids: keyword, the flag of its file, and its columns.
+_VEHICLE = (
+    ("rest", "zupt", lambda t: _columns(t, REST_COLUMNS, "rest")),
+    ("odometer", "odometer", lambda t: _columns(t, ODOMETER_COLUMNS, "odometer")),
+    ("heading", "dual-antenna", _heading),
+)
 
 
 def read_imu(path: PathLike, **options: Any) -> pd.DataFrame:
@@ -252,6 +281,9 @@ def navigate(
     imu: Union[PathLike, Table],
     gnss: Union[PathLike, Table, None] = None,
     baro: Union[PathLike, Table, None] = None,
+    odometer: Union[PathLike, Table, None] = None,
+    heading: Union[PathLike, Table, None] = None,
+    rest: Union[PathLike, Table, None] = None,
     **options: Any,
 ) -> NavResult:
     """Navigate an IMU log, free-inertial or aided, as ``schuler nav`` does.
@@ -264,6 +296,20 @@ def navigate(
 
     ``gnss``: a path or a table of :func:`read_gnss`'s columns (velocity optional).
     ``baro``: a path or a table with ``t_s``, ``h_m``.
+
+    Vehicle aids, each a path (the file of the CLI's flag) or a table with the file's
+    columns and units: ``odometer`` (``--odometer``): ``t_s``, ``speed_mps`` (forward
+    speed of the point at ``vehicle_lever_arm``, negative reversing); ``heading``
+    (``--dual-antenna``): ``t_s``, ``heading_deg`` (the antenna baseline's, from true
+    north, clockwise), ``heading_std_deg``, optionally ``pitch_deg`` and
+    ``pitch_std_deg`` (the baseline's direction in the body: ``dual_antenna_baseline_yaw``,
+    ``dual_antenna_baseline_pitch`` [deg]); ``rest`` (``--zupt``): ``t0_s``, ``t1_s``,
+    intervals the vehicle stood still (zero-velocity updates every ``zupt_interval``,
+    with ``zaru=True`` zero-rate updates too). Their options are the CLI's:
+    ``odometer_std``, ``odometer_scale_std``, ``zupt_std``, ``nhc=True``, ... A 2-D
+    array gives the columns in that order. A bad value raises :class:`InputError`
+    naming ``<odometer array>`` (``<heading array>``, ``<rest array>``), the 1-based
+    row and the column.
 
     ``options``: ``schuler nav``'s flags with underscores, e.g. ``init_pos=(lat_deg,
     lon_deg, h_m)``, ``init_vel=(vn, ve, vd)`` [m/s], ``init_att=(roll, pitch, yaw)``
@@ -295,23 +341,40 @@ def navigate(
         flags.append(f"--baro={os.fspath(baro)}")
     elif baro is not None:
         kwargs["baro"] = _baro(baro)
+    given = dict(odometer=odometer, heading=heading, rest=rest)
+    for name, flag, columns in _VEHICLE:
+        table = given[name]
+        if isinstance(table, (str, os.PathLike)):
+            flags.append(f"--{flag}={os.fspath(table)}")
+        elif table is not None:
+            kwargs[name] = columns(table)
     return NavResult._of(_schuler.navigate(flags, **kwargs))
 
 
 class Session:
     """A navigation session fed sample by sample or in blocks (live data, custom
     loops). ``options`` as :func:`navigate`'s (aids are pushed, not read from files);
-    ``gnss=True``, ``baro=True`` set the filter up for the fixes and heights that will
-    be pushed (the vehicle aids' options, ``nhc=True`` and so on, likewise). The
-    start is the given state: ``align`` and ``init="gnss"`` are :func:`navigate`'s.
+    ``gnss=True``, ``baro=True``, ``odometer=True``, ``heading=True``, ``rest=True``
+    set the filter up for the aids that will be pushed, as their files would (the
+    vehicle aids' options, ``nhc=True``, ``odometer_scale_std`` and so on, likewise).
+    The start is the given state: ``align`` and ``init="gnss"`` are :func:`navigate`'s.
 
     Aids pushed before the IMU reaches their time are applied at their own time;
     ``take()`` returns what was produced since the last call, ``finish()`` the rest
     with ``smoothed`` and ``summary``.
     """
 
-    def __init__(self, gnss: bool = False, baro: bool = False, **options: Any) -> None:
-        self._native = _schuler.Session(_flags(options) + ["--imu=<session>"], gnss, baro)
+    def __init__(
+        self,
+        gnss: bool = False,
+        baro: bool = False,
+        odometer: bool = False,
+        heading: bool = False,
+        rest: bool = False,
+        **options: Any,
+    ) -> None:
+        flags = _flags(options) + ["--imu=<session>"]
+        self._native = _schuler.Session(flags, gnss, baro, rest=rest, odometer=odometer, heading=heading)
 
     def push_imu(self, t: float, dtheta: Sequence[float], dvel: Sequence[float], dt: Optional[float] = None) -> None:
         """One IMU sample: interval end ``t`` [s], increments ``dtheta`` [rad] and
@@ -331,6 +394,23 @@ class Session:
     def push_baro(self, t: float, h_m: float) -> None:
         """One barometric height [m] at ``t`` [s]."""
         self._native.push_baro(t, h_m)
+
+    def push_odometer(self, t: float, speed_mps: float) -> None:
+        """One odometer reading: forward speed [m/s] at ``t`` [s] (a line of
+        ``--odometer``'s file; needs ``odometer=True``)."""
+        self._native.push_odometer(float(t), float(speed_mps))
+
+    def push_heading(self, t: float, heading_deg: float, heading_std_deg: float, pitch_deg: Optional[float] = None, pitch_std_deg: Optional[float] = None) -> None:
+        """One dual-antenna reading at ``t`` [s]: the baseline's heading from true north
+        and its standard deviation [deg], optionally its pitch and standard deviation
+        [deg] (a line of ``--dual-antenna``'s file; needs ``heading=True``)."""
+        opt = lambda x: None if x is None else float(x)  # noqa: E731
+        self._native.push_heading(float(t), float(heading_deg), float(heading_std_deg), opt(pitch_deg), opt(pitch_std_deg))
+
+    def push_rest(self, t0_s: float, t1_s: float) -> None:
+        """The vehicle at rest from ``t0_s`` to ``t1_s`` [s] (a line of ``--zupt``'s
+        file; needs ``rest=True``); pushed before the IMU reaches ``t0_s``."""
+        self._native.push_rest(float(t0_s), float(t1_s))
 
     def take(self) -> NavResult:
         """The tables produced since the last ``take``."""

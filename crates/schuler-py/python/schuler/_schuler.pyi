@@ -31,10 +31,25 @@ def navigate(
     imu_dt: Optional[F64] = None,
     gnss: Optional[Sequence[F64]] = None,
     baro: Optional[Tuple[F64, F64]] = None,
-) -> Dict[str, Any]: ...
+    rest: Optional[Sequence[F64]] = None,
+    odometer: Optional[Sequence[F64]] = None,
+    heading: Optional[Sequence[F64]] = None,
+) -> Dict[str, Any]:
+    """``schuler nav``; ``rest``: ``t0_s, t1_s`` [s]; ``odometer``: ``t_s, speed_mps``
+    [s, m/s]; ``heading``: ``t_s, heading_deg, heading_std_deg[, pitch_deg,
+    pitch_std_deg]`` [s, deg]."""
+    ...
 
 class Session:
-    def __init__(self, flags: List[str], gnss: bool = False, baro: bool = False) -> None: ...
+    def __init__(
+        self,
+        flags: List[str],
+        gnss: bool = False,
+        baro: bool = False,
+        rest: bool = False,
+        odometer: bool = False,
+        heading: bool = False,
+    ) -> None: ...
     def push_imu(
         self, t: float, dtheta: Sequence[float], dvel: Sequence[float], dt: Optional[float] = None
     ) -> None: ...
@@ -50,6 +65,22 @@ class Session:
         vel_std_ned_mps: Optional[Sequence[float]] = None,
     ) -> None: ...
     def push_baro(self, t: float, h_m: float) -> None: ...
+    def push_rest(self, t0_s: float, t1_s: float) -> None:
+        """At rest from ``t0_s`` to ``t1_s`` [s]."""
+        ...
+    def push_odometer(self, t: float, speed_mps: float) -> None:
+        """Forward speed [m/s] at ``t`` [s]."""
+        ...
+    def push_heading(
+        self,
+        t: float,
+        heading_deg: float,
+        heading_std_deg: float,
+        pitch_deg: Optional[float] = None,
+        pitch_std_deg: Optional[float] = None,
+    ) -> None:
+        """Dual-antenna baseline heading and pitch with their std [deg] at ``t`` [s]."""
+        ...
     def take(self) -> Dict[str, Any]: ...
     def finish(self) -> Dict[str, Any]: ...
 
