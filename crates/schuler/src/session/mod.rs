@@ -150,8 +150,11 @@ pub struct Summary {
     /// Mean normalized innovation squared per dimension of the accepted measurements
     /// (NaN without any).
     pub mean_nis_per_dof: f64,
-    /// The filter's state layout, when it ran.
+    /// The filter's state layout, when it ran (the psi-angle filters).
     pub layout: Option<Layout>,
+    /// How many states the filter had at the end, when it ran: its layout's, or the
+    /// 18 of [`crate::filter::seed18`] (which has no [`Layout`]).
+    pub states: Option<usize>,
     /// The filter's sensor-error estimates at the end, when it ran.
     pub estimates: Option<crate::filter::SensorEstimates>,
     /// The vehicle mount at the end (the configured one with the estimated mounting
@@ -496,6 +499,7 @@ impl<E: EarthModel> Session<E> {
             Core::FilterWander(i) => filter_end(i, &run.cfg)?,
             Core::FilterSeed18(i) => FilterEnd {
                 counts: i.counts,
+                states: Some(crate::filter::seed18::model::N),
                 estimates: Some(i.estimates()),
                 ..FilterEnd::default()
             },
@@ -523,6 +527,7 @@ impl<E: EarthModel> Session<E> {
                 gate_resets: run.gate_resets,
                 mean_nis_per_dof: if dof > 0 { sum / dof as f64 } else { f64::NAN },
                 layout: end.layout,
+                states: end.states,
                 estimates: end.estimates,
                 mounting: end.mounting,
                 baro_loop: run.baro_loop.map(|l| l.counts),
@@ -601,6 +606,7 @@ fn epoch_of<E: EarthModel>(core: &Core<E>) -> Epoch {
 struct FilterEnd {
     counts: Counts,
     layout: Option<Layout>,
+    states: Option<usize>,
     estimates: Option<crate::filter::SensorEstimates>,
     mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
     smoothed: Option<SmoothedTrajectory>,
@@ -630,6 +636,7 @@ fn filter_end<M: ErrorFrame, E: EarthModel>(
     Ok(FilterEnd {
         counts: i.counts,
         layout: Some(i.layout()),
+        states: Some(i.layout().n),
         estimates: Some(i.estimates()),
         mounting,
         smoothed,
