@@ -581,7 +581,7 @@ fn the_session_runs_the_18_state_filter() {
         a.pos, b.pos, finished.summary.counts.position, finished.summary.counts.velocity
     );
     assert_eq!(a, b);
-    assert_eq!(finished.summary.counts, direct.counts);
+    assert_eq!(finished.summary.counts, direct.book.counts);
     assert_eq!(finished.summary.estimates, Some(direct.estimates()));
 }
 

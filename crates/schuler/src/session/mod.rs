@@ -45,7 +45,8 @@ use vehicle::VehicleRun;
 use crate::analysis::errors::NavRecord;
 use crate::channel::vertical::DetectorCounts;
 use crate::earth::EarthModel;
-use crate::filter::integration::{Counts, Innovation, Rejected, SkipReason, Skipped};
+use crate::filter::gate_book::GateBook;
+use crate::filter::integration::{Counts, SkipReason, Skipped};
 use crate::filter::measurement::Kind;
 use crate::filter::seed18::Seed18;
 use crate::filter::smoother::SmoothedTrajectory;
@@ -498,7 +499,7 @@ impl<E: EarthModel> Session<E> {
             Core::FilterNed(i) => filter_end(i, &run.cfg)?,
             Core::FilterWander(i) => filter_end(i, &run.cfg)?,
             Core::FilterSeed18(i) => FilterEnd {
-                counts: i.counts,
+                counts: i.book.counts,
                 states: Some(crate::filter::seed18::model::N),
                 estimates: Some(i.estimates()),
                 ..FilterEnd::default()
@@ -634,7 +635,7 @@ fn filter_end<M: ErrorFrame, E: EarthModel>(
         None
     };
     Ok(FilterEnd {
-        counts: i.counts,
+        counts: i.book.counts,
         layout: Some(i.layout()),
         states: Some(i.layout().n),
         estimates: Some(i.estimates()),
@@ -871,23 +872,19 @@ impl Loop {
 
     /// Move what the filter recorded into the events.
     fn take_records<M: ErrorFrame, E: EarthModel>(&mut self, integ: &mut Integrator<M, E>) {
-        self.take(
-            &mut integ.innovations,
-            &mut integ.rejected,
-            &mut integ.skipped,
-            &mut integ.gate_resets,
-        );
+        self.take(&mut integ.book);
     }
 
     /// Move a filter's records (tested, refused, skipped measurements, gate resets)
     /// into the events.
-    fn take(
-        &mut self,
-        innovations: &mut Vec<Innovation>,
-        rejected: &mut Vec<Rejected>,
-        skipped: &mut Vec<Skipped>,
-        gate_resets: &mut Vec<(f64, f64)>,
-    ) {
+    fn take(&mut self, book: &mut GateBook) {
+        let GateBook {
+            innovations,
+            rejected,
+            skipped,
+            gate_resets,
+            ..
+        } = book;
         if !innovations.is_empty() {
             for i in innovations.drain(..) {
                 if i.accepted {
@@ -924,12 +921,7 @@ impl Loop {
     }
 
     fn take_seed18<E: EarthModel>(&mut self, f: &mut Seed18<E>) {
-        self.take(
-            &mut f.innovations,
-            &mut f.rejected,
-            &mut f.skipped,
-            &mut f.gate_resets,
-        );
+        self.take(&mut f.book);
     }
 
     /// At the end of the input under the 18-state filter: fixes after the last
