@@ -29,27 +29,8 @@ fn nav(imu: &Path, out: &Path, extra: &[&str]) -> assert_cmd::assert::Assert {
         .arg(data.join("GNSS.txt"))
         .arg("--gnss-vel")
         .arg(data.join("GNSS_vel.txt"))
-        .args([
-            "--gnss-vel-std",
-            "0.05 m/s",
-            "--init-pos",
-            "45.0712345678,7.6812345678,245",
-            "--init-att",
-            "0,0,10",
-            "--start",
-            "1.0",
-            "--arw",
-            "0.1 deg/sqrt(h)",
-            "--vrw",
-            "0.08 m/s/sqrt(h)",
-            "--gyro-bias-std",
-            "2 deg/h",
-            "--accel-bias-std",
-            "300 mGal",
-            "--output-rate",
-            "1",
-            "--out",
-        ])
+        .args(common::DRIVE9MIN_START_AND_NOISE)
+        .args(["--gnss-vel-std", "0.05 m/s", "--output-rate", "1", "--out"])
         .arg(out)
         .args(extra)
         .assert()

@@ -38,12 +38,12 @@
 //! own) would double its weight and let `ψ` wander by it in the covariance while the
 //! data pin it.
 
+use super::filter::{self, Matrix6};
 use super::invariant::InvariantWindow;
 use crate::imu::ImuSample;
 use crate::rotation::dcm_from_rotation_vector;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-type Matrix6 = SMatrix<f64, 6, 6>;
 type Vector6 = SVector<f64, 6>;
 
 /// The Kalman filter on the units' attitude difference `ψ = ψ₁ − ψ₂` (inertial axes)
@@ -62,14 +62,9 @@ impl TwoUnitFilter {
     /// the drift difference [rad/s] per axis; `arw` the two units' angle random walks
     /// [rad/√s].
     pub fn new(attitude_std: Vector3<f64>, drift_std: Vector3<f64>, arw: [f64; 2]) -> Self {
-        let mut p = Matrix6::zeros();
-        for k in 0..3 {
-            p[(k, k)] = attitude_std[k].powi(2);
-            p[(k + 3, k + 3)] = drift_std[k].powi(2);
-        }
         Self {
             x: Vector6::zeros(),
-            p,
+            p: filter::prior(&attitude_std, &drift_std),
             arw2: arw[0].powi(2) + arw[1].powi(2),
         }
     }
@@ -117,13 +112,12 @@ impl TwoUnitFilter {
 
     /// The standard deviation of `u · ψ` for a unit vector `u` (inertial axes) [rad].
     pub fn attitude_std_along(&self, u: &Vector3<f64>) -> f64 {
-        let p = self.p.fixed_view::<3, 3>(0, 0);
-        (u.transpose() * p * u)[(0, 0)].max(0.0).sqrt()
+        filter::std_along(&self.p, u)
     }
 
     /// Standard deviations of the drift difference per body axis [rad/s].
     pub fn drift_std(&self) -> Vector3<f64> {
-        Vector3::from_fn(|k, _| self.p[(k + 3, k + 3)].max(0.0).sqrt())
+        filter::drift_std(&self.p)
     }
 }
 
