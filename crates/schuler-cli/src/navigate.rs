@@ -191,6 +191,7 @@ fn run_facts<'a>(
         nav_file,
         mechanization: s.first_mechanization,
         layout: s.layout.unwrap_or_else(Layout::core),
+        states: s.states.unwrap_or(Layout::core().n),
         samples: s.samples,
         t_first: s.t_first,
         t_last: s.t_last,

@@ -202,21 +202,8 @@ fn gnss_aided_is_at_least_as_accurate_as_kf_gins() {
         .arg(&imu)
         .arg("--gnss")
         .arg(common::test_data("drive9min").join("GNSS.txt"))
+        .args(common::DRIVE9MIN_START_AND_NOISE)
         .args([
-            "--init-pos",
-            "45.0712345678,7.6812345678,245",
-            "--init-att",
-            "0,0,10",
-            "--start",
-            "1.0",
-            "--arw",
-            "0.1 deg/sqrt(h)",
-            "--vrw",
-            "0.08 m/s/sqrt(h)",
-            "--gyro-bias-std",
-            "2 deg/h",
-            "--accel-bias-std",
-            "300 mGal",
             "--gyro-bias-instability",
             "0.2 deg/h",
             "--accel-bias-instability",

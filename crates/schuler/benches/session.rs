@@ -141,7 +141,7 @@ fn aided_loop(d: &Data) -> f64 {
     let mut sum = 0.0;
     for x in &d.samples[1..] {
         integ.step_with_fixes(black_box(x), &mut fixes);
-        integ.innovations.clear();
+        integ.book.innovations.clear();
         if decimator.take(x.t, x.dt) {
             sum += integ.state().pos.h + FilterEpoch::of(&integ).nav_std[0].x;
         }

@@ -6,17 +6,16 @@
 use nalgebra::Vector3;
 use schuler::analysis::consistency::{ChiSquareTest, mean_bounds, normalized_squared};
 use schuler::analysis::errors::errors_between;
-use schuler::earth::{EarthModel, Wgs84};
+use schuler::earth::Wgs84;
 use schuler::filter::ImuNoise;
 use schuler::filter::integration::{GnssFix, Innovation, IntegrationConfig, Integrator};
 use schuler::filter::measurement::Kind;
-use schuler::imu::ImuSample;
-use schuler::nav::{LocalLevel, NavState};
-use schuler::sim::analytic::Kinematics;
+use schuler::nav::LocalLevel;
 use schuler::sim::imu_model::ImuSimulator;
-use schuler::sim::receivers::{BaroReading, GnssModel, GnssSimulator, Interval};
-use schuler::sim::run::{ScenarioSpec, SimSink, simulate};
+use schuler::sim::receivers::{GnssModel, Interval};
 use std::sync::OnceLock;
+mod common;
+use common::{Data, scenario, simulated};
 
 const SCENARIO: &str = r#"
 seed = 1
@@ -100,57 +99,13 @@ preset = "tactical"
 const OUTAGES: [(f64, f64); 3] = [(900.0, 960.0), (1800.0, 1860.0), (2700.0, 2760.0)];
 const LEVER: [f64; 3] = [0.8, 0.3, -1.2];
 
-/// The exact increments, the truth at every sample, and at each whole second the
-/// truth and the body rate relative to NED (for the GNSS simulator).
-struct Data {
-    exact: Vec<ImuSample>,
-    truth: Vec<NavState>,
-    gnss_epochs: Vec<(NavState, Vector3<f64>)>,
-}
-
-impl SimSink for Data {
-    fn imu(
-        &mut self,
-        exact: &ImuSample,
-        _m: &ImuSample,
-        truth: &NavState,
-        kin: &Kinematics,
-    ) -> std::io::Result<()> {
-        self.exact.push(*exact);
-        self.truth.push(*truth);
-        if (truth.t - truth.t.round()).abs() < 1e-6 {
-            let l = Wgs84.local(truth.pos.lat, truth.pos.h);
-            let w_in = l.w_ie_n() + l.w_en_n(&truth.v_n);
-            let w_nb = kin.w_ib_b - truth.q_bn.inverse() * w_in;
-            self.gnss_epochs.push((*truth, w_nb));
-        }
-        Ok(())
-    }
-    fn gnss(&mut self, _f: &schuler::sim::receivers::GnssFix) -> std::io::Result<()> {
-        Ok(())
-    }
-    fn baro(&mut self, _b: &BaroReading) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
 fn data() -> &'static Data {
     static DATA: OnceLock<Data> = OnceLock::new();
-    DATA.get_or_init(|| {
-        let spec: ScenarioSpec = toml::from_str(SCENARIO).expect("scenario");
-        let mut d = Data {
-            exact: Vec::new(),
-            truth: Vec::new(),
-            gnss_epochs: Vec::new(),
-        };
-        simulate(&spec, &mut d).expect("simulate");
-        d
-    })
+    DATA.get_or_init(|| simulated(&scenario(SCENARIO)))
 }
 
 fn tactical() -> schuler::imu::model::ImuModel {
-    let spec: ScenarioSpec = toml::from_str(SCENARIO).expect("scenario");
-    spec.imu.model().expect("imu")
+    scenario(SCENARIO).imu.model().expect("imu")
 }
 
 /// GNSS fixes of one run: RTK-grade noise (2 cm, 2 cm, 5 cm; 2 cm/s), lever arm, the
@@ -170,24 +125,7 @@ fn fixes(seed: u64, outliers: &[(f64, Vector3<f64>)]) -> (Vec<GnssFix>, usize) {
             .map(|&(t, jump)| schuler::sim::receivers::Outlier { t, jump })
             .collect(),
     };
-    let mut sim = GnssSimulator::new(model, seed);
-    let mut out = Vec::new();
-    let mut injected = 0;
-    for (s, w) in &data().gnss_epochs {
-        if s.t < 1.0 {
-            continue;
-        }
-        if let Some(f) = sim.fix(&Wgs84, s, w) {
-            injected += usize::from(f.outlier);
-            out.push(GnssFix {
-                t: f.t,
-                pos: f.pos,
-                pos_std: f.pos_std,
-                vel: Some((f.v_n, f.vel_std)),
-            });
-        }
-    }
-    (out, injected)
+    common::gnss_fixes(data(), model, seed)
 }
 
 /// Per-second errors of a run: NED position error, velocity error, attitude error ψ,
@@ -272,7 +210,7 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
     let rejected_outliers = outlier_times
         .iter()
         .filter(|t| {
-            let hit = integ.rejected.iter().any(|r| (*t - r.t).abs() < 1e-6);
+            let hit = integ.book.rejected.iter().any(|r| (*t - r.t).abs() < 1e-6);
             if !hit {
                 println!("outlier at {t} not rejected");
             }
@@ -298,9 +236,9 @@ fn run_full(seed: u64, gnss: &[GnssFix], outlier_times: &[f64], smooth: bool, ba
         .collect();
     Run {
         epochs,
-        innovations: std::mem::take(&mut integ.innovations),
+        innovations: std::mem::take(&mut integ.book.innovations),
         smoothed,
-        rejected: integ.rejected.len(),
+        rejected: integ.book.rejected.len(),
         rejected_outliers,
     }
 }

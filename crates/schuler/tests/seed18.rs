@@ -5,9 +5,11 @@
 //!     mechanization, one perturbed in every state: the residual is second order,
 //!     so doubling the perturbation quadruples it;
 //! (b) the 18-state and the psi-angle 15-state filters on the same simulated data
-//!     (a drive, a polar-flight leg; GNSS aided, wander mechanization for both):
-//!     estimates within one standard deviation of each other;
-//! (c) the NEES of both over 20 Monte-Carlo runs in the chi-square 95 % band.
+//!     (a drive, a polar-flight leg from 89° N, the demo's helicopter sortie; GNSS
+//!     aided, wander mechanization for both): estimates within one standard deviation
+//!     of each other;
+//! (c) the NEES of both over 20 Monte-Carlo runs of the drive and of the polar leg in
+//!     the chi-square 95 % band.
 
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3, Vector4};
 use schuler::analysis::consistency::{mean_bounds, normalized_squared};
@@ -20,52 +22,16 @@ use schuler::filter::measurement::c_nc;
 use schuler::filter::seed18::Seed18;
 use schuler::filter::seed18::model::{self, N, Point, q4};
 use schuler::imu::ImuSample;
-use schuler::nav::{ErrorFrame, Mechanization, NavState, Wander, WanderState};
+use schuler::nav::{ErrorFrame, Mechanization, Wander, WanderState};
 use schuler::rotation::quaternion_from_rotation_vector;
-use schuler::sim::analytic::Kinematics;
 use schuler::sim::imu_model::ImuSimulator;
-use schuler::sim::receivers::{BaroReading, GnssModel, GnssSimulator};
-use schuler::sim::run::{ScenarioSpec, SimSink, simulate};
+use schuler::sim::receivers::{self, GnssModel};
+use schuler::sim::run::ScenarioSpec;
+use schuler::sim::scenario::SegmentSpec;
 use std::sync::OnceLock;
 
-/// A drive like `examples/drive.toml`, 8 minutes, without the lever arm (the paper's
-/// measurements are of the INS itself).
-const DRIVE: &str = r#"
-seed = 7
-earth = "wgs84"
-[start]
-time = 0.0
-position = ["45.07 deg", "7.68 deg", "245 m"]
-attitude = ["0 deg", "0 deg", "10 deg"]
-[[motion]]
-type = "hold"
-duration = "30 s"
-[[motion]]
-type = "accelerate"
-to_speed = "20 m/s"
-accel = "1 m/s^2"
-[[motion]]
-type = "turn"
-angle = "90 deg"
-rate = "3 deg/s"
-[[motion]]
-type = "climb"
-to_height = "290 m"
-pitch = "3 deg"
-[[motion]]
-type = "hold"
-duration = "120 s"
-[[motion]]
-type = "turn"
-angle = "-180 deg"
-bank = "10 deg"
-[[motion]]
-type = "hold"
-duration = "180 s"
-[imu]
-rate_hz = 200
-preset = "tactical"
-"#;
+mod common;
+use common::{Data, EXAMPLE_DRIVE, EXAMPLE_SORTIE, scenario, simulated, with_holds};
 
 /// A polar-flight leg: from 89° N at 100 m/s towards the pole with a turn, 5 minutes.
 const POLAR: &str = r#"
@@ -91,58 +57,78 @@ rate_hz = 200
 preset = "tactical"
 "#;
 
-/// The exact increments, the truth, and the GNSS epochs (truth and body rate
-/// relative to the Earth).
-#[derive(Default)]
-struct Data {
-    exact: Vec<ImuSample>,
-    truth: Vec<NavState>,
-    gnss_epochs: Vec<(NavState, Vector3<f64>)>,
+/// The simulated data sets the filters run on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Case {
+    /// `examples/drive.toml` shortened to 8 minutes (holds of 30, 120 and 180 s).
+    Drive,
+    /// [`POLAR`].
+    Polar,
+    /// The demo's sortie (`examples/polar_flight.toml`, navigation-grade FOG with the
+    /// rotor's vibration) shortened as the demo's `--quick` is: 200 Hz, a minute on
+    /// the pad, then the take-off and the route's first leg (70.0 to 70.35° N, 40 km at
+    /// 70 m/s, banked turns, a climb) to the hover: 14 minutes.
+    Sortie,
 }
 
-impl SimSink for Data {
-    fn imu(
-        &mut self,
-        exact: &ImuSample,
-        _m: &ImuSample,
-        truth: &NavState,
-        kin: &Kinematics,
-    ) -> std::io::Result<()> {
-        self.exact.push(*exact);
-        self.truth.push(*truth);
-        if (truth.t - truth.t.round()).abs() < 1e-6 {
-            let w_ie_n = Wgs84.w_ie_n(truth.pos.lat);
-            let w_eb = kin.w_ib_b - truth.q_bn.inverse() * w_ie_n;
-            self.gnss_epochs.push((*truth, w_eb));
+impl Case {
+    /// The scenario, without its receivers (the tests simulate their own GNSS, at
+    /// the INS: the paper's measurements are of the INS itself).
+    fn spec(self) -> ScenarioSpec {
+        let mut s = match self {
+            Case::Drive => with_holds(scenario(EXAMPLE_DRIVE), &["30 s", "120 s", "180 s"]),
+            Case::Polar => scenario(POLAR),
+            Case::Sortie => {
+                let mut s = with_holds(scenario(EXAMPLE_SORTIE), &["60 s"]);
+                s.imu.rate_hz = 200.0;
+                for seg in &mut s.motion {
+                    if let SegmentSpec::Route { waypoints, .. } = seg {
+                        waypoints.truncate(1);
+                    }
+                }
+                s
+            }
+        };
+        s.gnss = None;
+        s.baro = None;
+        s
+    }
+
+    fn data(self) -> &'static Data {
+        static DATA: [OnceLock<Data>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+        DATA[self as usize].get_or_init(|| simulated(&self.spec()))
+    }
+
+    /// GNSS fixes at 1 Hz at the INS (no lever arm): the drive's and the polar leg's
+    /// 0.5 m, 0.5 m, 1 m and 0.05, 0.05, 0.1 m/s (as `examples/drive.toml`); the
+    /// sortie's code-phase 1.5 m, 1.5 m, 3 m with the same velocity noise and a 60-s
+    /// outage in the leg (as `examples/polar_flight.toml`'s two minutes).
+    fn gnss(self) -> GnssModel {
+        let sortie = self == Case::Sortie;
+        GnssModel {
+            interval: 1.0,
+            pos_std: if sortie {
+                Vector3::new(1.5, 1.5, 3.0)
+            } else {
+                Vector3::new(0.5, 0.5, 1.0)
+            },
+            vel_std: Vector3::new(0.05, 0.05, 0.1),
+            lever_arm: Vector3::zeros(),
+            outages: if sortie {
+                vec![receivers::Interval {
+                    start: SORTIE_OUTAGE.0,
+                    end: SORTIE_OUTAGE.1,
+                }]
+            } else {
+                Vec::new()
+            },
+            outliers: Vec::new(),
         }
-        Ok(())
-    }
-    fn gnss(&mut self, _f: &schuler::sim::receivers::GnssFix) -> std::io::Result<()> {
-        Ok(())
-    }
-    fn baro(&mut self, _b: &BaroReading) -> std::io::Result<()> {
-        Ok(())
     }
 }
 
-fn spec(text: &str) -> ScenarioSpec {
-    toml::from_str(text).expect("scenario")
-}
-
-fn data(which: &'static str) -> &'static Data {
-    static DRIVE_DATA: OnceLock<Data> = OnceLock::new();
-    static POLAR_DATA: OnceLock<Data> = OnceLock::new();
-    let cell = if which == DRIVE {
-        &DRIVE_DATA
-    } else {
-        &POLAR_DATA
-    };
-    cell.get_or_init(|| {
-        let mut d = Data::default();
-        simulate(&spec(which), &mut d).expect("simulate");
-        d
-    })
-}
+/// The GNSS outage in the sortie's leg [s].
+const SORTIE_OUTAGE: (f64, f64) = (400.0, 460.0);
 
 // ---------------------------------------------------------------------------
 // (a) the transition against two nonlinear runs
@@ -187,7 +173,7 @@ fn blocks(x: &SVector<f64, N>) -> [f64; 4] {
 /// `start` s, the perturbation `scale` times a fixed one; the actual and the
 /// predicted (`Φ x0`, `Φ` chained over `step`-second intervals) difference.
 fn linearisation(scale: f64, step: f64) -> (SVector<f64, N>, SVector<f64, N>) {
-    let d = data(POLAR);
+    let d = Case::Polar.data();
     let first = 20 * 200;
     let samples = &d.exact[first..first + 60 * 200];
     let truth = d.truth[first];
@@ -286,48 +272,29 @@ fn transition_matches_two_nonlinear_runs_to_second_order() {
 // ---------------------------------------------------------------------------
 // (b), (c): the two filters on the same data
 
-fn tactical(which: &str) -> schuler::imu::model::ImuModel {
-    spec(which).imu.model().expect("imu")
+/// The scenario's IMU model (the sensor errors each run draws).
+fn imu_model(case: Case) -> schuler::imu::model::ImuModel {
+    case.spec().imu.model().expect("imu")
 }
 
-/// GNSS fixes at 1 Hz: 0.5 m, 0.5 m, 1 m; 0.05, 0.05, 0.1 m/s (as examples/drive.toml),
-/// at the INS (no lever arm).
-fn fixes(which: &'static str, seed: u64) -> Vec<GnssFix> {
-    let model = GnssModel {
-        interval: 1.0,
-        pos_std: Vector3::new(0.5, 0.5, 1.0),
-        vel_std: Vector3::new(0.05, 0.05, 0.1),
-        lever_arm: Vector3::zeros(),
-        outages: Vec::new(),
-        outliers: Vec::new(),
-    };
-    let mut sim = GnssSimulator::new(model, seed);
-    data(which)
-        .gnss_epochs
-        .iter()
-        .filter(|(s, _)| s.t >= 1.0)
-        .filter_map(|(s, w)| sim.fix_w_eb(&Wgs84, s, w))
-        .map(|f| GnssFix {
-            t: f.t,
-            pos: f.pos,
-            pos_std: f.pos_std,
-            vel: Some((f.v_n, f.vel_std)),
-        })
-        .collect()
+fn fixes(case: Case, seed: u64) -> Vec<GnssFix> {
+    common::gnss_fixes(case.data(), case.gnss(), seed).0
 }
 
-fn config(which: &str) -> IntegrationConfig {
+fn config(case: Case) -> IntegrationConfig {
     IntegrationConfig {
         init_pos_std: Vector3::repeat(0.5),
         init_vel_std: Vector3::repeat(0.05),
         init_att_std: Vector3::new(0.05, 0.05, 0.2).map(f64::to_radians),
-        ..IntegrationConfig::new(ImuNoise::from_model(&tactical(which)))
+        ..IntegrationConfig::new(ImuNoise::from_model(&imu_model(case)))
     }
 }
 
 /// One second of both filters: the estimates, the errors against the truth and the
 /// covariances of `[position NED, velocity NED, ψ]`.
 struct Both {
+    /// Time [s].
+    t: f64,
     /// Seed-18 estimate minus psi-15 estimate (position NED, velocity NED, ψ).
     diff: [f64; 9],
     /// Gyro drift and accelerometer bias estimates, seed-18 minus psi-15.
@@ -359,17 +326,17 @@ fn psi_cov(i: &Integrator<Wander<Wgs84>, Wgs84>) -> SMatrix<f64, 9, 9> {
     t * i.covariance().fixed_view::<9, 9>(0, 0) * t.transpose()
 }
 
-fn both(which: &'static str, imu_seed: u64, gnss_seed: u64) -> Vec<Both> {
-    let d = data(which);
-    let cfg = config(which);
-    let mut imu = ImuSimulator::new(tactical(which), imu_seed);
+fn both(case: Case, imu_seed: u64, gnss_seed: u64) -> Vec<Both> {
+    let d = case.data();
+    let cfg = config(case);
+    let mut imu = ImuSimulator::new(imu_model(case), imu_seed);
     let start = d.truth[0];
     let mut psi = Integrator::new(Wander::new(Wgs84, start), Wgs84, cfg);
     let mut seed = Seed18::new(Wander::new(Wgs84, start), cfg).expect("supported");
     let first = imu.measure(&d.exact[0]);
     psi.prime(&first);
     seed.prime(&first);
-    let gnss = fixes(which, gnss_seed);
+    let gnss = fixes(case, gnss_seed);
     let (mut f1, mut f2) = (
         gnss.iter().copied().peekable(),
         gnss.iter().copied().peekable(),
@@ -405,6 +372,7 @@ fn both(which: &'static str, imu_seed: u64, gnss_seed: u64) -> Vec<Both> {
         let nees =
             |e: SVector<f64, 9>, p: &SMatrix<f64, 9, 9>| normalized_squared(&e, p).expect("P > 0");
         out.push(Both {
+            t: truth.t,
             diff: diff.into(),
             sensor_diff: [sd[0].x, sd[0].y, sd[0].z, sd[1].x, sd[1].y, sd[1].z],
             std_psi: std(&pa, s_psi),
@@ -423,13 +391,21 @@ const NAMES: [&str; 15] = [
     "eps y", "eps z", "df x", "df y", "df z",
 ];
 
+/// The 18-state and the 15-state filter on the same data give the same estimates
+/// within one standard deviation of either, at every second: on the drive, on the
+/// polar leg and on the demo's sortie (a minute on the pad, the take-off, the first
+/// leg with a 60-s GNSS outage, the navigation-grade FOG shaken by the rotor).
 #[test]
 fn seed18_and_psi15_agree_within_one_sigma() {
-    for (which, name) in [(DRIVE, "drive"), (POLAR, "polar leg")] {
-        let epochs = both(which, 3, 4);
-        // Largest |difference| / sigma per state, and the largest ratio of the two
-        // filters' sigmas.
-        let mut worst = [0.0f64; 15];
+    for (case, name) in [
+        (Case::Drive, "drive"),
+        (Case::Polar, "polar leg"),
+        (Case::Sortie, "demo sortie"),
+    ] {
+        let epochs = both(case, 3, 4);
+        // Largest |difference| / sigma per state (and when), and the largest ratio
+        // of the two filters' sigmas.
+        let mut worst = [(0.0f64, 0.0f64); 15];
         let mut sigma_ratio = [1.0f64; 15];
         for e in &epochs {
             for k in 0..15 {
@@ -439,7 +415,9 @@ fn seed18_and_psi15_agree_within_one_sigma() {
                     e.sensor_diff[k - 9]
                 };
                 let s = e.std_psi[k].max(e.std_seed[k]);
-                worst[k] = worst[k].max(d.abs() / s);
+                if d.abs() / s > worst[k].0 {
+                    worst[k] = (d.abs() / s, e.t);
+                }
                 let r = e.std_seed[k] / e.std_psi[k];
                 if (r - 1.0).abs() > (sigma_ratio[k] - 1.0).abs() {
                     sigma_ratio[k] = r;
@@ -449,27 +427,28 @@ fn seed18_and_psi15_agree_within_one_sigma() {
         println!("{name}: {} epochs", epochs.len());
         for k in 0..15 {
             println!(
-                "  {:6}: max |seed18 - psi15| / sigma {:.3}, sigma ratio seed18/psi15 up to {:.3}",
-                NAMES[k], worst[k], sigma_ratio[k]
+                "  {:6}: max |seed18 - psi15| / sigma {:.3} (at {:.0} s), sigma ratio seed18/psi15 up to {:.4}",
+                NAMES[k], worst[k].0, worst[k].1, sigma_ratio[k]
             );
         }
         for k in 0..15 {
             assert!(
-                worst[k] <= 1.0,
+                worst[k].0 <= 1.0,
                 "{name}: {} differs by {} sigma",
                 NAMES[k],
-                worst[k]
+                worst[k].0
             );
         }
     }
 }
 
-#[test]
-fn nees_of_both_filters_is_consistent_over_20_runs() {
-    let runs = 20u64;
+/// The mean NEES of both filters over `runs` Monte-Carlo runs of `case` (the IMU's
+/// errors and the GNSS noise drawn anew per run), against the chi-square 95 % band of
+/// a `runs`-run mean of 9 degrees of freedom.
+fn nees_is_consistent(case: Case, runs: u64) {
     let mut sums: Vec<[f64; 2]> = Vec::new();
     for k in 0..runs {
-        let epochs = both(DRIVE, 300 + k, 400 + k);
+        let epochs = both(case, 300 + k, 400 + k);
         if sums.is_empty() {
             sums = vec![[0.0; 2]; epochs.len()];
         }
@@ -487,14 +466,26 @@ fn nees_of_both_filters_is_consistent_over_20_runs() {
             .count() as f64
             / sums.len() as f64;
         println!(
-            "{name}: mean NEES {mean:.2} over {runs} runs x {} epochs (95 % interval of a 20-run mean {:.2}..{:.2}; {:.0} % of epochs inside)",
+            "{case:?} {name}: mean NEES {mean:.2} over {runs} runs x {} epochs (95 % interval of a {runs}-run mean {:.2}..{:.2}; {:.0} % of epochs inside)",
             sums.len(),
             b.lo,
             b.hi,
             100.0 * inside
         );
-        assert!(b.contains(mean), "{name}: mean NEES {mean}");
+        assert!(b.contains(mean), "{case:?} {name}: mean NEES {mean}");
     }
+}
+
+#[test]
+fn nees_of_both_filters_is_consistent_over_20_runs() {
+    nees_is_consistent(Case::Drive, 20);
+}
+
+/// The polar leg from 89° N (the wander frame's home, where the psi filter in NED
+/// could not run): 20 runs of 5 minutes.
+#[test]
+fn nees_of_both_filters_is_consistent_on_the_polar_leg() {
+    nees_is_consistent(Case::Polar, 20);
 }
 
 // ---------------------------------------------------------------------------
@@ -521,7 +512,7 @@ fn seed18_session(cfg: IntegrationConfig, choice: MechanizationChoice) -> Sessio
 
 #[test]
 fn the_session_refuses_what_the_18_state_model_lacks() {
-    let cfg = config(DRIVE);
+    let cfg = config(Case::Drive);
     let refused = |c: SessionConfig| c.validate().expect_err("refused");
     let e = refused(seed18_session(cfg, MechanizationChoice::Auto));
     assert_eq!(e.field, "filter.error_model");
@@ -556,11 +547,11 @@ fn the_session_refuses_what_the_18_state_model_lacks() {
 /// final state, bit for bit, and the same counts.
 #[test]
 fn the_session_runs_the_18_state_filter() {
-    let d = data(DRIVE);
-    let cfg = config(DRIVE);
-    let gnss = fixes(DRIVE, 4);
+    let d = Case::Drive.data();
+    let cfg = config(Case::Drive);
+    let gnss = fixes(Case::Drive, 4);
     let measured: Vec<ImuSample> = {
-        let mut imu = ImuSimulator::new(tactical(DRIVE), 3);
+        let mut imu = ImuSimulator::new(imu_model(Case::Drive), 3);
         d.exact.iter().map(|s| imu.measure(s)).collect()
     };
     let mut direct = Seed18::new(Wander::new(Wgs84, d.truth[0]), cfg).expect("supported");
@@ -590,7 +581,7 @@ fn the_session_runs_the_18_state_filter() {
         a.pos, b.pos, finished.summary.counts.position, finished.summary.counts.velocity
     );
     assert_eq!(a, b);
-    assert_eq!(finished.summary.counts, direct.counts);
+    assert_eq!(finished.summary.counts, direct.book.counts);
     assert_eq!(finished.summary.estimates, Some(direct.estimates()));
 }
 
@@ -600,12 +591,12 @@ fn the_session_runs_the_18_state_filter() {
 /// has the variance the velocity noise feeds it).
 #[test]
 fn norm_directions_stay_out_of_the_covariance() {
-    let d = data(POLAR);
-    let cfg = config(POLAR);
-    let mut imu = ImuSimulator::new(tactical(POLAR), 5);
+    let d = Case::Polar.data();
+    let cfg = config(Case::Polar);
+    let mut imu = ImuSimulator::new(imu_model(Case::Polar), 5);
     let mut f = Seed18::new(Wander::new(Wgs84, d.truth[0]), cfg).expect("supported");
     f.prime(&imu.measure(&d.exact[0]));
-    let gnss = fixes(POLAR, 6);
+    let gnss = fixes(Case::Polar, 6);
     let mut queue = gnss.iter().copied().peekable();
     for s in &d.exact[1..] {
         f.step_with_fixes(&imu.measure(s), &mut queue);

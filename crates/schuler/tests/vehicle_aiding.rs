@@ -379,7 +379,12 @@ fn run_with(
         }
     }
     // Every tested measurement, accepted or refused.
-    let nis: Vec<(Kind, f64)> = integ.innovations.iter().map(|n| (n.kind, n.nis)).collect();
+    let nis: Vec<(Kind, f64)> = integ
+        .book
+        .innovations
+        .iter()
+        .map(|n| (n.kind, n.nis))
+        .collect();
     let p = integ.covariance();
     let bias = [
         integ.estimates().gyro_bias,
@@ -394,8 +399,8 @@ fn run_with(
         Run {
             epochs,
             nis,
-            rejected: integ.rejected.len(),
-            counts: integ.counts,
+            rejected: integ.book.rejected.len(),
+            counts: integ.book.counts,
             mount: (aids.mount.corrected(&integ.estimates().mounting), mount_std),
         },
         bias,

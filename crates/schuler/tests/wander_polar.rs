@@ -513,10 +513,10 @@ fn gnss_aided_flight_over_the_pole_keeps_mid_latitude_accuracy() {
     println!(
         "over the pole (max lat {:.6} deg): horizontal error with GNSS {aided:.3} m, in the outage at the pole {bridged:.2} m; {} fixes rejected",
         max_lat.to_degrees(),
-        integ.counts.rejected
+        integ.book.counts.rejected
     );
     assert!(max_lat.to_degrees() > 89.999);
-    assert_eq!(integ.counts.rejected, 0);
+    assert_eq!(integ.book.counts.rejected, 0);
     assert!(aided < 0.15, "{aided}");
     assert!(bridged < 17.7, "{bridged}");
 }

@@ -112,6 +112,8 @@ pub struct RunFacts<'a> {
     pub mechanization: MechanizationKind,
     /// The filter's states.
     pub layout: Layout,
+    /// How many (18 under `--error-model seed18`, else the layout's).
+    pub states: usize,
     /// IMU samples integrated.
     pub samples: u64,
     /// First time [s].
@@ -475,7 +477,7 @@ fn build(
         f.t_last,
         f.t_last - f.t_first,
         f.mechanization,
-        f.layout.n,
+        f.states,
         f.fixes.len(),
         gaps.len()
     ));

@@ -18,6 +18,25 @@ pub fn test_data(name: &str) -> PathBuf {
     dir
 }
 
+/// `nav` flags of the drive9min data set: the truth's state at t = 1.0 s (its README's
+/// KF-GINS set-up) and the IMU noise the data were made with.
+pub const DRIVE9MIN_START_AND_NOISE: [&str; 14] = [
+    "--init-pos",
+    "45.0712345678,7.6812345678,245",
+    "--init-att",
+    "0,0,10",
+    "--start",
+    "1.0",
+    "--arw",
+    "0.1 deg/sqrt(h)",
+    "--vrw",
+    "0.08 m/s/sqrt(h)",
+    "--gyro-bias-std",
+    "2 deg/h",
+    "--accel-bias-std",
+    "300 mGal",
+];
+
 /// The decompressed bytes of an `.xz` file.
 pub fn unxz(path: &Path) -> Vec<u8> {
     let mut input = std::io::BufReader::new(std::fs::File::open(path).expect("open .xz"));

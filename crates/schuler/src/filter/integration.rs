@@ -18,6 +18,7 @@
 //! carried over the offset with the body rate).
 
 use super::error_model::ErrorModel;
+use super::gate_book::GateBook;
 use super::interval::Interval;
 use super::kalman::{Gate, Kalman, Rejection};
 use super::layout::Layout;
@@ -239,19 +240,8 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     interval: Interval,
     estimates: SensorEstimates,
     w_ib_b: Vector3<f64>,
-    /// Gate decisions, in time order.
-    pub rejected: Vec<Rejected>,
-    /// Measurements outside the IMU span, in time order.
-    pub skipped: Vec<Skipped>,
-    /// Every measurement tested, in time order (take it with `std::mem::take` now
-    /// and then to bound memory on long runs).
-    pub innovations: Vec<Innovation>,
-    /// Counters.
-    pub counts: Counts,
-    /// Times at which the gate was bypassed after `reset_after` refusals in a row, with
-    /// the normalized innovation squared of the fix then accepted.
-    pub gate_resets: Vec<(f64, f64)>,
-    consecutive_rejections: u32,
+    /// The measurements tested, refused and skipped, the counts and gate resets.
+    pub book: GateBook,
     /// The record for the smoother, when smoothing.
     smoother: Option<super::smoother::SmootherLog>,
 }
@@ -327,12 +317,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             interval: Interval::default(),
             estimates: SensorEstimates::default(),
             w_ib_b: Vector3::zeros(),
-            rejected: Vec::new(),
-            skipped: Vec::new(),
-            innovations: Vec::new(),
-            counts: Counts::default(),
-            gate_resets: Vec::new(),
-            consecutive_rejections: 0,
+            book: GateBook::default(),
             smoother: None,
         }
     }
@@ -552,12 +537,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             interval: Interval::default(),
             estimates: self.estimates,
             w_ib_b: self.w_ib_b,
-            rejected: self.rejected,
-            skipped: self.skipped,
-            innovations: self.innovations,
-            counts: self.counts,
-            gate_resets: self.gate_resets,
-            consecutive_rejections: self.consecutive_rejections,
+            book: self.book,
             smoother: self.smoother,
         }
     }
@@ -569,8 +549,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 
     /// Record a measurement of `kind` that could not be used.
     pub fn skip_measurement(&mut self, t: f64, kind: Kind, reason: SkipReason) {
-        self.counts.skipped += 1;
-        self.skipped.push(Skipped { t, kind, reason });
+        self.book.skip(t, kind, reason);
     }
 
     /// Apply a GNSS fix now (position, then velocity if present).
@@ -601,61 +580,19 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         }
     }
 
-    /// Gate a measurement, record it in [`Integrator::innovations`] and, if
-    /// accepted, update and feed back.
+    /// Gate a measurement, record it in [`Integrator::book`] and, if accepted,
+    /// update and feed back.
     pub fn apply(&mut self, t: f64, m: Measurement) -> bool {
-        let position = m.kind == Kind::GnssPosition;
-        let reset = position
-            && self.cfg.reset_after > 0
-            && self.consecutive_rejections >= self.cfg.reset_after;
-        // A reset still refuses the impossible: an innovation beyond
-        // RESET_MAX_SIGMA standard deviations per degree of freedom.
-        let gate = if reset {
-            Gate::Bound(RESET_MAX_SIGMA * RESET_MAX_SIGMA * m.z.len() as f64)
-        } else {
-            self.cfg.gate
-        };
+        let (gate, reset) = self.book.gate(&self.cfg, m.kind, m.z.len());
         let outcome = self.kf.update(&m.z, &m.h, &m.r, gate);
-        let (nis, s_diag) = match &outcome {
-            Ok(u) => (u.nis, &u.s_diag),
-            Err(r) => (r.nis, &r.s_diag),
+        let Some(u) = self.book.record(t, m.kind, m.z, reset, outcome) else {
+            return false;
         };
-        self.innovations.push(Innovation {
-            t,
-            kind: m.kind,
-            z: m.z,
-            s_diag: s_diag.clone(),
-            nis,
-            accepted: outcome.is_ok(),
-        });
-        match outcome {
-            Ok(u) => {
-                if reset {
-                    self.gate_resets.push((t, u.nis));
-                }
-                if position {
-                    self.consecutive_rejections = 0;
-                }
-                self.counts.accept(m.kind);
-                self.feed_back(&u.dx);
-                if let Some(log) = self.smoother.as_mut() {
-                    log.feedback(&u.dx, &self.kf.p);
-                }
-                true
-            }
-            Err(rejection) => {
-                if position {
-                    self.consecutive_rejections += 1;
-                }
-                self.counts.rejected += 1;
-                self.rejected.push(Rejected {
-                    t,
-                    kind: m.kind,
-                    rejection,
-                });
-                false
-            }
+        self.feed_back(&u.dx);
+        if let Some(log) = self.smoother.as_mut() {
+            log.feedback(&u.dx, &self.kf.p);
         }
+        true
     }
 
     fn feed_back(&mut self, dx: &nalgebra::DVector<f64>) {

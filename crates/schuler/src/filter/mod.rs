@@ -17,6 +17,7 @@
 //!   innovation gate.
 
 pub mod error_model;
+pub mod gate_book;
 pub mod integration;
 pub mod interval;
 pub mod kalman;

@@ -6,7 +6,7 @@
 use super::invariant::InvariantWindow;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-type Matrix6 = SMatrix<f64, 6, 6>;
+pub(super) type Matrix6 = SMatrix<f64, 6, 6>;
 type Vector6 = SVector<f64, 6>;
 
 /// Noise of the refinement's model.
@@ -32,14 +32,9 @@ impl RefineFilter {
     /// Zero estimates with independent priors: attitude [rad] and drift [rad/s] per
     /// axis.
     pub fn new(attitude_std: Vector3<f64>, drift_std: Vector3<f64>) -> Self {
-        let mut p = Matrix6::zeros();
-        for k in 0..3 {
-            p[(k, k)] = attitude_std[k].powi(2);
-            p[(k + 3, k + 3)] = drift_std[k].powi(2);
-        }
         Self {
             x: Vector6::zeros(),
-            p,
+            p: prior(&attitude_std, &drift_std),
         }
     }
 
@@ -98,12 +93,32 @@ impl RefineFilter {
 
     /// The standard deviation of `u · ψ` for a unit vector `u` (inertial axes) [rad].
     pub fn attitude_std_along(&self, u: &Vector3<f64>) -> f64 {
-        let p = self.p.fixed_view::<3, 3>(0, 0);
-        (u.transpose() * p * u)[(0, 0)].max(0.0).sqrt()
+        std_along(&self.p, u)
     }
 
     /// Standard deviations of the drift per body axis [rad/s].
     pub fn drift_std(&self) -> Vector3<f64> {
-        Vector3::from_fn(|k, _| self.p[(k + 3, k + 3)].max(0.0).sqrt())
+        drift_std(&self.p)
     }
+}
+
+/// Independent priors of `[ψ, ε]`: attitude [rad] and drift [rad/s] per axis.
+pub(super) fn prior(attitude_std: &Vector3<f64>, drift_std: &Vector3<f64>) -> Matrix6 {
+    let mut p = Matrix6::zeros();
+    for k in 0..3 {
+        p[(k, k)] = attitude_std[k].powi(2);
+        p[(k + 3, k + 3)] = drift_std[k].powi(2);
+    }
+    p
+}
+
+/// The standard deviation of `u · ψ` under the covariance `p` of `[ψ, ε]`.
+pub(super) fn std_along(p: &Matrix6, u: &Vector3<f64>) -> f64 {
+    let p = p.fixed_view::<3, 3>(0, 0);
+    (u.transpose() * p * u)[(0, 0)].max(0.0).sqrt()
+}
+
+/// The drift's standard deviations per axis under the covariance `p` of `[ψ, ε]`.
+pub(super) fn drift_std(p: &Matrix6) -> Vector3<f64> {
+    Vector3::from_fn(|k, _| p[(k + 3, k + 3)].max(0.0).sqrt())
 }

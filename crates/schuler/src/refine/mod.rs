@@ -84,12 +84,24 @@
 //! turns, and seen after a roll.
 //!
 //! [`RefineFilter`] is the six-state Kalman filter on `[ψ, ε]` with this observation.
+//!
+//! [`SecondUnitRefinement`] is the mode with a second strapdown unit as the source
+//! (its rates turned by its own attitude): the observation is then the difference of
+//! the two units' inertial rotations, it sees the *differences* of their attitude
+//! errors and drifts, and its noise is the units' own angle random walk, shared with
+//! the attitude difference's process noise ([`TwoUnitFilter`]).
+//! `tests/refine_second_unit.rs` flies it with two simulated FOG units in a hovering
+//! helicopter near the pole: the vertical drift difference converges as
+//! `1/σ² = 1/σ₀² + T/(q₁² + q₂²)`, tilt and horizontal drift separate after the
+//! pirouettes' rate changes, the heading difference stays at its prior until a roll.
 
 mod filter;
 mod invariant;
+mod second_unit;
 
 pub use filter::{RefineFilter, RefineNoise};
 pub use invariant::{
     InvariantWindow, earth_to_inertial, invariant, nav_rate_from_euler_rates, own_rate_nb,
     reference_increment,
 };
+pub use second_unit::{SecondUnitRefinement, TwoUnitFilter};

@@ -45,7 +45,8 @@ use vehicle::VehicleRun;
 use crate::analysis::errors::NavRecord;
 use crate::channel::vertical::DetectorCounts;
 use crate::earth::EarthModel;
-use crate::filter::integration::{Counts, Innovation, Rejected, SkipReason, Skipped};
+use crate::filter::gate_book::GateBook;
+use crate::filter::integration::{Counts, SkipReason, Skipped};
 use crate::filter::measurement::Kind;
 use crate::filter::seed18::Seed18;
 use crate::filter::smoother::SmoothedTrajectory;
@@ -150,8 +151,11 @@ pub struct Summary {
     /// Mean normalized innovation squared per dimension of the accepted measurements
     /// (NaN without any).
     pub mean_nis_per_dof: f64,
-    /// The filter's state layout, when it ran.
+    /// The filter's state layout, when it ran (the psi-angle filters).
     pub layout: Option<Layout>,
+    /// How many states the filter had at the end, when it ran: its layout's, or the
+    /// 18 of [`crate::filter::seed18`] (which has no [`Layout`]).
+    pub states: Option<usize>,
     /// The filter's sensor-error estimates at the end, when it ran.
     pub estimates: Option<crate::filter::SensorEstimates>,
     /// The vehicle mount at the end (the configured one with the estimated mounting
@@ -495,7 +499,8 @@ impl<E: EarthModel> Session<E> {
             Core::FilterNed(i) => filter_end(i, &run.cfg)?,
             Core::FilterWander(i) => filter_end(i, &run.cfg)?,
             Core::FilterSeed18(i) => FilterEnd {
-                counts: i.counts,
+                counts: i.book.counts,
+                states: Some(crate::filter::seed18::model::N),
                 estimates: Some(i.estimates()),
                 ..FilterEnd::default()
             },
@@ -523,6 +528,7 @@ impl<E: EarthModel> Session<E> {
                 gate_resets: run.gate_resets,
                 mean_nis_per_dof: if dof > 0 { sum / dof as f64 } else { f64::NAN },
                 layout: end.layout,
+                states: end.states,
                 estimates: end.estimates,
                 mounting: end.mounting,
                 baro_loop: run.baro_loop.map(|l| l.counts),
@@ -601,6 +607,7 @@ fn epoch_of<E: EarthModel>(core: &Core<E>) -> Epoch {
 struct FilterEnd {
     counts: Counts,
     layout: Option<Layout>,
+    states: Option<usize>,
     estimates: Option<crate::filter::SensorEstimates>,
     mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
     smoothed: Option<SmoothedTrajectory>,
@@ -628,8 +635,9 @@ fn filter_end<M: ErrorFrame, E: EarthModel>(
         None
     };
     Ok(FilterEnd {
-        counts: i.counts,
+        counts: i.book.counts,
         layout: Some(i.layout()),
+        states: Some(i.layout().n),
         estimates: Some(i.estimates()),
         mounting,
         smoothed,
@@ -864,23 +872,19 @@ impl Loop {
 
     /// Move what the filter recorded into the events.
     fn take_records<M: ErrorFrame, E: EarthModel>(&mut self, integ: &mut Integrator<M, E>) {
-        self.take(
-            &mut integ.innovations,
-            &mut integ.rejected,
-            &mut integ.skipped,
-            &mut integ.gate_resets,
-        );
+        self.take(&mut integ.book);
     }
 
     /// Move a filter's records (tested, refused, skipped measurements, gate resets)
     /// into the events.
-    fn take(
-        &mut self,
-        innovations: &mut Vec<Innovation>,
-        rejected: &mut Vec<Rejected>,
-        skipped: &mut Vec<Skipped>,
-        gate_resets: &mut Vec<(f64, f64)>,
-    ) {
+    fn take(&mut self, book: &mut GateBook) {
+        let GateBook {
+            innovations,
+            rejected,
+            skipped,
+            gate_resets,
+            ..
+        } = book;
         if !innovations.is_empty() {
             for i in innovations.drain(..) {
                 if i.accepted {
@@ -917,12 +921,7 @@ impl Loop {
     }
 
     fn take_seed18<E: EarthModel>(&mut self, f: &mut Seed18<E>) {
-        self.take(
-            &mut f.innovations,
-            &mut f.rejected,
-            &mut f.skipped,
-            &mut f.gate_resets,
-        );
+        self.take(&mut f.book);
     }
 
     /// At the end of the input under the 18-state filter: fixes after the last

@@ -5,12 +5,13 @@
 use super::measure::{self, Measurement3};
 use super::model::{self, ACCEL, GYRO, HEIGHT, Mat18, N, NAV_Q, ORI_Q, Point, VEL};
 use crate::earth::EarthModel;
+use crate::filter::gate_book::GateBook;
 use crate::filter::integration::{
-    Counts, FixConsumer, FixSource, GnssFix, Innovation, IntegrationConfig, RESET_MAX_SIGMA,
-    Rejected, SensorEstimates, SkipReason, Skipped, step_with_fixes,
+    FixConsumer, FixSource, GnssFix, IntegrationConfig, SensorEstimates, SkipReason,
+    step_with_fixes,
 };
 use crate::filter::interval::Interval;
-use crate::filter::kalman::{Gate, Kalman};
+use crate::filter::kalman::Kalman;
 use crate::filter::measurement::Kind;
 use crate::imu::ImuSample;
 use crate::nav::{Mechanization, NavState, Wander, WanderState};
@@ -58,20 +59,11 @@ pub struct Seed18<E: EarthModel> {
     start: Point,
     interval: Interval,
     estimates: SensorEstimates,
-    /// Every measurement tested, in time order.
-    pub innovations: Vec<Innovation>,
-    /// Gate decisions, in time order.
-    pub rejected: Vec<Rejected>,
-    /// Fixes outside the IMU span, in time order.
-    pub skipped: Vec<Skipped>,
-    /// Counters.
-    pub counts: Counts,
-    /// Times at which the gate was bypassed after `reset_after` refusals in a row, with
-    /// the normalized innovation squared of the fix then accepted.
-    pub gate_resets: Vec<(f64, f64)>,
+    /// The measurements tested, refused and skipped, the counts and gate resets
+    /// (the same gate and reset rule as [`crate::filter::Integrator`]'s).
+    pub book: GateBook,
     /// Fixes not used because they fell within [`measure::POLE_COS_LAT`] of a pole.
     pub polar_skips: u64,
-    consecutive_rejections: u32,
 }
 
 fn dyn18(m: &Mat18) -> DMatrix<f64> {
@@ -113,13 +105,8 @@ impl<E: EarthModel> Seed18<E> {
             start,
             interval: Interval::default(),
             estimates: SensorEstimates::default(),
-            innovations: Vec::new(),
-            rejected: Vec::new(),
-            skipped: Vec::new(),
-            counts: Counts::default(),
-            gate_resets: Vec::new(),
+            book: GateBook::default(),
             polar_skips: 0,
-            consecutive_rejections: 0,
         })
     }
 
@@ -208,55 +195,19 @@ impl<E: EarthModel> Seed18<E> {
         }
     }
 
-    /// Gate a measurement, record it and, if accepted, update and feed back (the
-    /// same gate and reset rule as [`crate::filter::Integrator::apply`]).
+    /// Gate a measurement, record it in [`Seed18::book`] and, if accepted, update
+    /// and feed back.
     pub fn apply(&mut self, t: f64, kind: Kind, m: Measurement3) -> bool {
-        let position = kind == Kind::GnssPosition;
-        let reset = position
-            && self.cfg.reset_after > 0
-            && self.consecutive_rejections >= self.cfg.reset_after;
-        let gate = if reset {
-            Gate::Bound(RESET_MAX_SIGMA * RESET_MAX_SIGMA * 3.0)
-        } else {
-            self.cfg.gate
-        };
+        let (gate, reset) = self.book.gate(&self.cfg, kind, 3);
         let z = DVector::from_column_slice(m.z.as_slice());
         let h = DMatrix::from_column_slice(3, N, m.h.as_slice());
         let r = DMatrix::from_column_slice(3, 3, m.r.as_slice());
         let outcome = self.kf.update(&z, &h, &r, gate);
-        let (nis, s_diag) = match &outcome {
-            Ok(u) => (u.nis, u.s_diag.clone()),
-            Err(e) => (e.nis, e.s_diag.clone()),
+        let Some(u) = self.book.record(t, kind, z, reset, outcome) else {
+            return false;
         };
-        self.innovations.push(Innovation {
-            t,
-            kind,
-            z,
-            s_diag,
-            nis,
-            accepted: outcome.is_ok(),
-        });
-        match outcome {
-            Ok(u) => {
-                if reset {
-                    self.gate_resets.push((t, u.nis));
-                }
-                if position {
-                    self.consecutive_rejections = 0;
-                }
-                self.counts.accept(kind);
-                self.feed_back(&u.dx);
-                true
-            }
-            Err(rejection) => {
-                if position {
-                    self.consecutive_rejections += 1;
-                }
-                self.counts.rejected += 1;
-                self.rejected.push(Rejected { t, kind, rejection });
-                false
-            }
-        }
+        self.feed_back(&u.dx);
+        true
     }
 
     /// Closed-loop feedback: `p ← (p̂ − δp)/|·|`, `q0 ← (q̂0 − δq0)/|·|`,
@@ -339,12 +290,7 @@ impl<E: EarthModel> Seed18<E> {
 
     /// Record a fix that could not be used.
     pub fn skip(&mut self, t: f64, reason: SkipReason) {
-        self.counts.skipped += 1;
-        self.skipped.push(Skipped {
-            t,
-            kind: Kind::GnssPosition,
-            reason,
-        });
+        self.book.skip(t, Kind::GnssPosition, reason);
     }
 
     /// Standard deviations of the gyro drifts and accelerometer biases.
