@@ -21,6 +21,7 @@ use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
 use crate::options::{EarthChoice, GradeChoice, GravityChoice, MechanizationChoice, Triple, rate};
+use crate::read_ahead::ReadAhead;
 use anyhow::{Context, Result, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
@@ -726,7 +727,7 @@ pub fn run(args: NavArgs) -> Result<()> {
     let mut aiding: Option<Aiding> = plan.aiding.resolve(filter_grade(&plan).noise()?)?;
     let settings = &plan.settings;
     let started = Instant::now();
-    let mut reader = ImuReader::open(&settings.imu, &settings.read)?;
+    let reader = ImuReader::open(&settings.imu, &settings.read)?;
     eprintln!(
         "{}: {}, {}, nominal rate {:.6} Hz",
         settings.imu.display(),
@@ -740,11 +741,13 @@ pub fn run(args: NavArgs) -> Result<()> {
     let bar = progress_bar(&settings.imu);
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
+    // Parsed on a second thread, overlapping the navigation ([`ReadAhead`]).
+    let mut reader = ReadAhead::spawn(reader)?;
     let summary = navigate_samples(&plan, &mut aiding, &mut reader, &bar, on_sample)?;
-    bar.set_position(reader.bytes_read());
+    bar.set_position(progress.bytes());
     bar.finish_and_clear();
     let secs = started.elapsed().as_secs_f64();
-    if aiding.is_none() {
+    if let (None, Some(reader)) = (&aiding, reader.finish()) {
         let report = reader.gaps();
         if !report.is_empty() {
             eprintln!("warning: {}: {report}", settings.imu.display());
