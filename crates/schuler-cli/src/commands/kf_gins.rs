@@ -19,6 +19,7 @@ use crate::aided::{Aiding, OutputNames};
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions};
 use crate::navigate::{NavSettings, navigate};
 use crate::options::{EarthChoice, GravityChoice};
+use crate::read_ahead::ReadAhead;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
@@ -386,7 +387,10 @@ pub fn run(path: &Path, opts: &KfGinsOptions) -> Result<()> {
         aiding,
         gravity,
     } = load(path, opts)?;
-    let mut reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
+    let reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
+    // Parsed on a second thread, overlapping the navigation ([`ReadAhead`]); the
+    // items come in the same order, so the files are the same bytes.
+    let mut reader = ReadAhead::spawn(reader)?;
     let start = Start {
         estimates: aiding.initial_errors,
         ..settings.start()
