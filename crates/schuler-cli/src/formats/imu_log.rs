@@ -116,8 +116,10 @@ pub const GAP_FACTOR: f64 = 2.0;
 /// skipped (a median of fewer samples says too little).
 pub const LAYOUT_CHECK_MIN_INTERVALS: usize = 10;
 
-/// Read buffer for files [bytes].
-pub const READ_BUFFER_BYTES: usize = 1 << 20;
+/// Buffer of the `BufReader` [`ImuReader::open`] puts in front of a file [bytes]:
+/// the line reader reads in blocks of 256 KiB, which a small buffer passes through
+/// without a copy.
+pub const READ_BUFFER_BYTES: usize = 1 << 13;
 
 /// Which text format a log is in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -713,7 +715,7 @@ pub struct ImuReader<R> {
 }
 
 impl ImuReader<BufReader<File>> {
-    /// Opens the file at `path` behind a [`READ_BUFFER_BYTES`] buffer and reads its
+    /// Opens the file at `path` (behind a pass-through [`READ_BUFFER_BYTES`] buffer) and reads its
     /// first samples (see [`ImuReader::new`]).
     pub fn open(path: &Path, options: &ImuReadOptions) -> Result<Self, InputError> {
         let file = File::open(path).map_err(|e| {
@@ -738,7 +740,8 @@ impl<R: BufRead> ImuReader<R> {
     /// any and the first up to [`LOOKAHEAD_INTERVALS`] + 1 samples, fixes the nominal
     /// interval and runs the plausibility check.
     ///
-    /// For standard input, wrap it in a [`BufReader`] of [`READ_BUFFER_BYTES`] for speed.
+    /// Standard input needs no `BufReader` of its own (`stdin().lock()` is one): the
+    /// lines are read in large blocks.
     pub fn new(
         input: R,
         path: impl Into<PathBuf>,
