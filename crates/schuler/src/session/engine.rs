@@ -74,6 +74,10 @@ pub(crate) struct Switch {
     pub auto: bool,
     pub sin_enter: f64,
     pub sin_leave: f64,
+    /// A latitude [rad] 1 µrad below the hand-over's: below it `|sin φ|` is surely
+    /// below `sin_enter` (the sines differ by more than 1e-13 at any latitude, libm's
+    /// `sin` errs by an ulp), so the NED run skips its per-sample sine.
+    pub lat_clear: f64,
 }
 
 impl Switch {
@@ -82,6 +86,7 @@ impl Switch {
             auto: m.choice == MechanizationChoice::Auto,
             sin_enter: m.auto_latitude.sin(),
             sin_leave: (m.auto_latitude - m.hysteresis).sin(),
+            lat_clear: m.auto_latitude - 1e-6,
         }
     }
 
@@ -103,6 +108,16 @@ impl Switch {
                 MechanizationKind::Wander => sin_lat.abs() < self.sin_leave,
             }
     }
+
+    /// Whether `core` should hand over ([`Self::due`] at its latitude), without the
+    /// sine on an NED run clear of the hand-over latitude ([`Self::lat_clear`]): the
+    /// same answer at every sample.
+    #[inline]
+    pub fn due_for<E: EarthModel>(&self, core: &Core<E>) -> bool {
+        self.auto
+            && !core.ned_latitude_below(self.lat_clear)
+            && self.due(core.kind(), core.sin_lat())
+    }
 }
 
 impl<E: EarthModel> Core<E> {
@@ -112,6 +127,16 @@ impl<E: EarthModel> Core<E> {
             Core::Wander(_) | Core::FilterWander(_) | Core::FilterSeed18(_) => {
                 MechanizationKind::Wander
             }
+        }
+    }
+
+    /// Whether this is an NED run whose `|latitude|` is below `lat` [rad].
+    #[inline]
+    fn ned_latitude_below(&self, lat: f64) -> bool {
+        match self {
+            Core::Ned(m) => m.state().pos.lat.abs() < lat,
+            Core::FilterNed(i) => i.mechanization().state().pos.lat.abs() < lat,
+            _ => false,
         }
     }
 
@@ -153,5 +178,47 @@ impl<E: EarthModel> Core<E> {
             to: core.kind(),
         };
         (core, handover)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::earth::{Geodetic, Wgs84};
+    use nalgebra::UnitQuaternion;
+    use std::f64::consts::FRAC_PI_2;
+
+    /// The NED run's short cut decides as the sine does at every latitude, right up
+    /// to the hand-over latitude (a sweep in 1e-9 rad steps across it, both signs,
+    /// and for a hand-over latitude of 90° too).
+    #[test]
+    fn skipping_the_sine_decides_as_the_sine() {
+        for degrees in [75.0f64, 30.0, 89.9, 90.0] {
+            let config = MechanizationConfig {
+                auto_latitude: degrees.to_radians(),
+                ..MechanizationConfig::default()
+            };
+            let switch = Switch::new(&config);
+            let mut shortcuts = 0;
+            for k in -20_000i32..=20_000 {
+                for sign in [1.0, -1.0] {
+                    let lat = sign * (config.auto_latitude + f64::from(k) * 1e-9).min(FRAC_PI_2);
+                    let core = Core::Ned(LocalLevel::new(
+                        Wgs84,
+                        NavState {
+                            t: 0.0,
+                            pos: Geodetic::new(lat, 0.1, 100.0),
+                            v_n: Vector3::zeros(),
+                            q_bn: UnitQuaternion::identity(),
+                        },
+                    ));
+                    let by_sine = switch.due(core.kind(), core.sin_lat());
+                    assert_eq!(switch.due_for(&core), by_sine, "lat {lat}");
+                    shortcuts += usize::from(core.ned_latitude_below(switch.lat_clear));
+                }
+            }
+            // The sweep reaches below the clear latitude: the short cut was taken.
+            assert!(shortcuts > 0, "{degrees}");
+        }
     }
 }

@@ -558,8 +558,7 @@ impl<E: EarthModel> Session<E> {
         }
         run.samples += 1;
         run.done = Some((s.t, s.dt));
-        if run.switch.auto
-            && run.switch.due(core.kind(), core.sin_lat())
+        if run.switch.due_for(core)
             && let Some(old) = self.core.take()
         {
             let (new, handover) = old.handed_over();
