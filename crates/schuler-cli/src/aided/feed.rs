@@ -84,10 +84,15 @@ impl<'a> AidFeed<'a> {
         ];
         let mut sources = Vec::new();
         for kind in kinds {
+            // One pass checks every aid and the order (a GNSS store spilled to a file
+            // is read once here and once as it is fed).
+            let (mut sorted, mut last) = (true, f64::NEG_INFINITY);
             for aid in kind() {
                 aid.validate()?;
+                sorted &= last <= aid.t();
+                last = aid.t();
             }
-            if kind().is_sorted_by(|x, y| x.t() <= y.t()) {
+            if sorted {
                 sources.push(kind().peekable());
             } else {
                 for aid in kind() {

@@ -58,17 +58,13 @@ pub struct Fixes {
 }
 
 impl From<Vec<GnssFix>> for Fixes {
+    /// The fixes pushed one by one, then closed: the same path as a streamed log.
     fn from(fixes: Vec<GnssFix>) -> Self {
-        let mut store = Spilled::default();
+        let mut store = Self::default();
         for f in &fixes {
             store.push(f);
         }
-        Self {
-            store,
-            first: fixes.first().copied(),
-            last: fixes.last().copied(),
-            gaps: super::report::gnss_gaps(&fixes),
-        }
+        store.closed()
     }
 }
 
