@@ -17,7 +17,6 @@ pub mod navigate;
 pub mod options;
 pub mod output;
 pub mod plot;
-pub mod read_ahead;
 pub mod report;
 pub mod text_block;
 pub mod writer_thread;

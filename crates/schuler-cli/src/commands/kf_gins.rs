@@ -19,7 +19,6 @@ use crate::aided::{Aiding, OutputNames};
 use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions};
 use crate::navigate::{NavSettings, navigate};
 use crate::options::{EarthChoice, GravityChoice};
-use crate::read_ahead::ReadAhead;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
@@ -388,9 +387,9 @@ pub fn run(path: &Path, opts: &KfGinsOptions) -> Result<()> {
         gravity,
     } = load(path, opts)?;
     let reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
-    // Parsed on a second thread, overlapping the navigation ([`ReadAhead`]); the
-    // items come in the same order, so the files are the same bytes.
-    let mut reader = ReadAhead::spawn(reader)?;
+    // Read and parsed on a second thread, overlapping the navigation; the samples
+    // come in the same order, so the files are the same bytes.
+    let mut reader = reader.read_ahead()?;
     let start = Start {
         estimates: aiding.initial_errors,
         ..settings.start()

@@ -21,7 +21,6 @@ use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
 use crate::options::{EarthChoice, GradeChoice, GravityChoice, MechanizationChoice, Triple, rate};
-use crate::read_ahead::ReadAhead;
 use anyhow::{Context, Result, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::Vector3;
@@ -741,13 +740,13 @@ pub fn run(args: NavArgs) -> Result<()> {
     let bar = progress_bar(&settings.imu);
     let progress = reader.progress();
     let on_sample = |_| bar.set_position(progress.bytes());
-    // Parsed on a second thread, overlapping the navigation ([`ReadAhead`]).
-    let mut reader = ReadAhead::spawn(reader)?;
+    // Read and parsed on a second thread, overlapping the navigation.
+    let mut reader = reader.read_ahead()?;
     let summary = navigate_samples(&plan, &mut aiding, &mut reader, &bar, on_sample)?;
     bar.set_position(progress.bytes());
     bar.finish_and_clear();
     let secs = started.elapsed().as_secs_f64();
-    if let (None, Some(reader)) = (&aiding, reader.finish()) {
+    if aiding.is_none() {
         let report = reader.gaps();
         if !report.is_empty() {
             eprintln!("warning: {}: {report}", settings.imu.display());

@@ -101,6 +101,7 @@ use super::imu_columns::{
 };
 use super::imu_plausibility::{Reading, Sensor};
 use super::lines::{LineReadError, LineReader, MAX_LINE_BYTES, is_blank, is_skippable};
+use super::lines_ahead::{Lines, LinesAhead, Parsed};
 
 /// Standard gravity g₀ [m/s²] (CGPM 1901), the yardstick of the layout check.
 pub const STANDARD_GRAVITY: f64 = 9.806_65;
@@ -283,6 +284,7 @@ impl ProgressCounter {
 }
 
 /// How a line's fields map to slots (0 time, 1–3 gyro, 4–6 accelerometer).
+#[derive(Clone)]
 struct Columns {
     /// Separated by [`Self::delim`] only (CSV), else by blanks, commas or semicolons
     /// (text).
@@ -302,6 +304,36 @@ struct Columns {
 }
 
 impl Columns {
+    /// Parses `line`'s time (`time_only`) or all its columns into `out` (in slot
+    /// order); returns where the time lies.
+    #[inline]
+    fn parse(&self, line: &[u8], time_only: bool, out: &mut [f64; 7]) -> Result<Span, FieldError> {
+        let mut span = (0, 0);
+        if self.csv {
+            parse_csv_line(
+                line,
+                &self.slot_of_col,
+                self.delim,
+                (time_only, self.trailing),
+                out,
+                &mut span,
+            )?;
+        } else {
+            let ncols = if time_only {
+                self.time_col + 1
+            } else {
+                self.slot_of_col.len()
+            };
+            let slots = &self.slot_of_col;
+            if self.mapped {
+                parse_text_line::<true>(line, slots, ncols, self.trailing, out, &mut span)?;
+            } else {
+                parse_text_line::<false>(line, slots, ncols, false, out, &mut span)?;
+            }
+        }
+        Ok(span)
+    }
+
     /// KF-GINS text: 7 columns in slot order, named canonically for `layout`.
     fn kf_gins(layout: ImuLayout) -> Self {
         let names = match layout {
@@ -682,7 +714,7 @@ pub(super) fn median(values: &mut [f64]) -> Option<f64> {
 /// Iterating yields `Ok(sample)` per data line in the time window, or one `Err` and
 /// then nothing.
 pub struct ImuReader<R> {
-    lines: LineReader<R>,
+    lines: Lines<R>,
     path: PathBuf,
     format: ImuFormat,
     columns: Columns,
@@ -735,6 +767,28 @@ impl ImuReader<BufReader<File>> {
     }
 }
 
+impl<R: BufRead + Send + 'static> ImuReader<R> {
+    /// The rest of the log read, and its fields parsed, on a helper thread
+    /// ([`LinesAhead`]); the samples, errors and gaps are the same, in the same
+    /// order, while this reader's checks and conversions run on the thread that
+    /// iterates. Dropping the reader does not wait for the helper.
+    pub fn read_ahead(mut self) -> std::io::Result<Self> {
+        let Lines::Here(lines) =
+            std::mem::replace(&mut self.lines, Lines::Ahead(LinesAhead::ended()))
+        else {
+            return Ok(self);
+        };
+        let columns = self.columns.clone();
+        let parse = move |line: &[u8]| {
+            let mut values = [0.0; 7];
+            let time_span = columns.parse(line, false, &mut values).ok()?;
+            Some(Parsed { values, time_span })
+        };
+        self.lines = Lines::Ahead(LinesAhead::spawn(lines, parse)?);
+        Ok(self)
+    }
+}
+
 impl<R: BufRead> ImuReader<R> {
     /// Wraps `input` (named `path` in errors, e.g. `<stdin>`), reads the CSV header if
     /// any and the first up to [`LOOKAHEAD_INTERVALS`] + 1 samples, fixes the nominal
@@ -750,7 +804,7 @@ impl<R: BufRead> ImuReader<R> {
         let path = path.into();
         check_options(&path, options)?;
         let mut reader = Self {
-            lines: LineReader::new(input),
+            lines: Lines::Here(LineReader::new(input)),
             path,
             format: options.format,
             columns: Columns::kf_gins(ImuLayout::Increments),
@@ -1016,29 +1070,14 @@ impl<R: BufRead> ImuReader<R> {
     #[inline]
     fn parse_fields(&self, time_only: bool, out: &mut [f64; 7]) -> Result<f64, FieldError> {
         let line = self.lines.line();
-        let c = &self.columns;
-        let mut span = (0, 0);
-        if c.csv {
-            parse_csv_line(
-                line,
-                &c.slot_of_col,
-                c.delim,
-                (time_only, c.trailing),
-                out,
-                &mut span,
-            )?;
-        } else {
-            let ncols = if time_only {
-                c.time_col + 1
-            } else {
-                c.slot_of_col.len()
-            };
-            if c.mapped {
-                parse_text_line::<true>(line, &c.slot_of_col, ncols, c.trailing, out, &mut span)?;
-            } else {
-                parse_text_line::<false>(line, &c.slot_of_col, ncols, false, out, &mut span)?;
+        // Parsed ahead (all the fields, so the time too), else here.
+        let span = match self.lines.parsed() {
+            Some(p) => {
+                *out = p.values;
+                p.time_span
             }
-        }
+            None => self.columns.parse(line, time_only, out)?,
+        };
         match self.clock {
             (TimeUnit::S, 0.0) => Ok(out[0]),
             (unit, offset) => Ok(stamp_seconds(&line[span.0..span.1], out[0], unit, offset)),

@@ -12,6 +12,7 @@ pub mod imu_columns;
 pub mod imu_log;
 pub mod imu_plausibility;
 mod lines;
+mod lines_ahead;
 pub mod nav;
 pub mod nmea;
 pub mod rtklib;
