@@ -1436,6 +1436,86 @@ mod tests {
         s
     }
 
+    /// What a reader yields: each sample's bits, or the error's text.
+    fn transcript<R: BufRead>(
+        reader: Result<ImuReader<R>, InputError>,
+    ) -> Vec<Result<[u64; 8], String>> {
+        let reader = match reader {
+            Ok(r) => r,
+            Err(e) => return vec![Err(e.to_string())],
+        };
+        reader
+            .map(|s| {
+                s.map(|s| {
+                    let (a, b) = (s.dtheta, s.dvel);
+                    [s.t, s.dt, a.x, a.y, a.z, b.x, b.y, b.z].map(f64::to_bits)
+                })
+                .map_err(|e| e.to_string())
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// Read ahead ([`ImuReader::read_ahead`]), a log gives the samples and the error
+        /// it gives read here, bit for bit and at the same line: 2,000 to 5,000 lines
+        /// (several blocks) of KF-GINS text or CSV, in seconds or milliseconds, with a
+        /// window, and one line spoilt (a comment, a bad or missing field, a time going
+        /// back, a blank line, an overlong field) anywhere after the first samples.
+        #[test]
+        fn read_ahead_yields_what_is_read_here(
+            n in 2_000usize..5_000,
+            csv in any::<bool>(),
+            millis in any::<bool>(),
+            window in any::<bool>(),
+            spoil_at in 300usize..5_000,
+            spoil in 0usize..7,
+        ) {
+            let body = stationary_text(n, 200.0, 10.0, ImuLayout::Increments);
+            let mut lines: Vec<String> = body.lines().map(str::to_owned).collect();
+            if let Some(line) = lines.get_mut(spoil_at) {
+                *line = match spoil {
+                    0 => format!("# {line}"),
+                    1 => line.replacen(' ', " x", 2),
+                    2 => line.rsplit_once(' ').map_or("", |x| x.0).to_owned(),
+                    3 => line.replacen("1", "0", 1),
+                    4 => String::new(),
+                    5 => format!("{line} {}", "9".repeat(400)),
+                    _ => line.clone(),
+                };
+            }
+            let mut text = String::new();
+            if csv {
+                text.push_str("t,wx,wy,wz,fx,fy,fz\n");
+            }
+            for line in &lines {
+                let line = if csv { line.replace(' ', ",") } else { line.clone() };
+                let line = if millis {
+                    let sep = if csv { ',' } else { ' ' };
+                    match line.split_once(sep).map(|(t, rest)| (t.parse::<f64>(), rest)) {
+                        Some((Ok(t), rest)) => format!("{:.3}{sep}{rest}", t * 1e3),
+                        _ => line.clone(),
+                    }
+                } else {
+                    line
+                };
+                text.push_str(&line);
+                text.push('\n');
+            }
+            let options = ImuReadOptions {
+                format: if csv { ImuFormat::Csv } else { ImuFormat::KfGinsText },
+                time_unit: millis.then_some(TimeUnit::Ms),
+                t_start: window.then_some(12.0),
+                t_end: window.then_some(28.0),
+                ..ImuReadOptions::default()
+            };
+            let here = || ImuReader::new(std::io::Cursor::new(text.clone().into_bytes()), PATH, &options);
+            let ahead = here().map(|r| r.read_ahead().expect("helper thread"));
+            prop_assert_eq!(transcript(ahead), transcript(here()));
+        }
+    }
+
     #[test]
     fn good_text_file_parses_to_exact_values() {
         let input = "# KF-GINS IMU file\n\

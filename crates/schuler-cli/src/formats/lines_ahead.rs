@@ -8,9 +8,8 @@
 //! a free-inertial run's work about evenly between the two cores: the helper reads
 //! and parses the numbers, the navigation thread checks them and navigates.
 //!
-//! When the consumer has taken every block the helper made (it waits for the
-//! helper), the helper leaves one data line in [`LEFT_TO_CONSUMER`] of its next block
-//! unparsed, for the consumer to parse: the work then balances between the threads
+//! While the consumer has taken every block the helper made (it waits for the
+//! helper), the helper leaves one line in [`LEFT_TO_CONSUMER`] unparsed, for the consumer to parse: the work then balances between the threads
 //! whichever is the slower. Which lines are parsed where changes only the timing:
 //! both parse with the same function.
 //!
@@ -220,26 +219,22 @@ fn read_all<R: Read>(
         let mut block = spare.try_recv().unwrap_or_default();
         block.text.clear();
         block.entries.clear();
-        // The consumer has taken every block: leave it some parsing (module doc).
-        let share = if in_flight.load(Ordering::Relaxed) == 0 {
-            LEFT_TO_CONSUMER
-        } else {
-            usize::MAX
-        };
         while block.entries.len() < BLOCK_LINES && block.end.is_none() {
             match lines.next_line() {
                 Ok(true) => {
                     let line = lines.line();
                     let start = block.text.len();
                     block.text.extend_from_slice(line);
+                    // While the consumer has taken every block, it waits: leave it
+                    // some parsing (module doc).
+                    let leave = (block.entries.len() + 1).is_multiple_of(LEFT_TO_CONSUMER)
+                        && in_flight.load(Ordering::Relaxed) == 0;
                     block.entries.push(Entry {
                         start,
                         end: block.text.len(),
                         line_no: lines.line_no(),
                         bytes: lines.bytes(),
-                        parsed: if is_skippable(line)
-                            || (block.entries.len() + 1).is_multiple_of(share)
-                        {
+                        parsed: if leave || is_skippable(line) {
                             None
                         } else {
                             parse(line)
