@@ -962,12 +962,12 @@ impl<R: BufRead> ImuReader<R> {
 
     /// Bytes consumed from the input so far (including the lookahead).
     pub fn bytes_read(&self) -> u64 {
-        self.lines.bytes()
+        self.lines.at().bytes
     }
 
     /// A handle on the byte count that outlives borrows of the reader.
     pub fn progress(&self) -> ProgressCounter {
-        ProgressCounter(self.lines.progress())
+        ProgressCounter(std::sync::Arc::clone(&self.lines.at().progress))
     }
 
     fn error(
@@ -993,7 +993,7 @@ impl<R: BufRead> ImuReader<R> {
         };
         self.error(
             InputErrorKind::Header,
-            self.lines.line_no(),
+            self.lines.at().line_no,
             e.field.as_deref(),
             format!("{}{detected}", e.message),
         )
@@ -1005,13 +1005,13 @@ impl<R: BufRead> ImuReader<R> {
             Ok(more) => Ok(more),
             Err(LineReadError::Io(e)) => Err(self.error(
                 InputErrorKind::Io,
-                self.lines.line_no() + 1,
+                self.lines.at().line_no + 1,
                 None,
                 format!("read failed: {e}"),
             )),
             Err(LineReadError::TooLong) => Err(self.error(
                 InputErrorKind::LineTooLong,
-                self.lines.line_no(),
+                self.lines.at().line_no,
                 None,
                 format!("line longer than {MAX_LINE_BYTES} bytes (is this a text IMU log?)"),
             )),
@@ -1030,7 +1030,7 @@ impl<R: BufRead> ImuReader<R> {
 
     #[cold]
     fn field_error(&self, e: FieldError) -> InputError {
-        let line_no = self.lines.line_no();
+        let line_no = self.lines.at().line_no;
         let line = self.lines.line();
         let expected = self.columns.slot_of_col.len();
         match e {
@@ -1100,7 +1100,7 @@ impl<R: BufRead> ImuReader<R> {
             Ok(t) => t,
             Err(e) => return Err(self.field_error(e)),
         };
-        let line_no = self.lines.line_no();
+        let line_no = self.lines.at().line_no;
         if let Some((t_prev, line_prev)) = self.last
             && t <= t_prev
         {

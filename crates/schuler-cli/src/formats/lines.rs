@@ -33,7 +33,7 @@ pub fn read_lines_whole(path: &Path) -> Result<Vec<u8>, InputError> {
                 out.push(b'\n');
             }
             Err(LineReadError::Io(e)) => return Err(cannot_read(path, &e)),
-            Err(LineReadError::TooLong) => return Err(too_long(path, r.line_no())),
+            Err(LineReadError::TooLong) => return Err(too_long(path, r.at().line_no)),
         }
     }
 }
@@ -53,7 +53,7 @@ pub(crate) fn for_each_data_line(
         match r.next_line() {
             Ok(false) => return Ok(()),
             Ok(true) => {
-                let n = r.line_no();
+                let n = r.at().line_no;
                 let bytes = match r.line() {
                     l if n == 1 => l.strip_prefix(BOM).unwrap_or(l),
                     l => l,
@@ -67,7 +67,7 @@ pub(crate) fn for_each_data_line(
                 }
             }
             Err(LineReadError::Io(e)) => return Err(cannot_read(path, &e)),
-            Err(LineReadError::TooLong) => return Err(too_long(path, r.line_no())),
+            Err(LineReadError::TooLong) => return Err(too_long(path, r.at().line_no)),
         }
     }
 }
@@ -157,11 +157,19 @@ pub(crate) struct LineReader<R> {
     end: usize,
     /// Whether the input has ended.
     eof: bool,
+    at: Position,
+}
+
+/// Where a line reader stands: the current line's number and the bytes consumed
+/// through it, with a counter of the bytes read that another thread may watch.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Position {
     /// 1-based number of the current line (0 before the first).
-    line_no: u64,
-    /// Bytes consumed so far, mirrored into `progress`.
-    bytes: u64,
-    progress: Arc<AtomicU64>,
+    pub line_no: u64,
+    /// Bytes consumed up to the current line's end.
+    pub bytes: u64,
+    /// Bytes read so far (a progress bar's; ahead of `bytes` when read ahead).
+    pub progress: Arc<AtomicU64>,
 }
 
 impl<R: Read> LineReader<R> {
@@ -174,9 +182,7 @@ impl<R: Read> LineReader<R> {
             pos: 0,
             end: 0,
             eof: false,
-            line_no: 0,
-            bytes: 0,
-            progress: Arc::new(AtomicU64::new(0)),
+            at: Position::default(),
         }
     }
 
@@ -202,10 +208,10 @@ impl<R: Read> LineReader<R> {
                     continue;
                 }
             };
-            self.line_no += 1;
-            self.bytes += (next - self.pos) as u64;
+            self.at.line_no += 1;
+            self.at.bytes += (next - self.pos) as u64;
             // A plain store: one writer, readers only want a recent value.
-            self.progress.store(self.bytes, Ordering::Relaxed);
+            self.at.progress.store(self.at.bytes, Ordering::Relaxed);
             if content_end - self.pos >= MAX {
                 return Err(LineReadError::TooLong);
             }
@@ -247,28 +253,17 @@ impl<R: Read> LineReader<R> {
     #[inline]
     pub(crate) fn line(&self) -> &[u8] {
         let line = &self.buf[self.line.0..self.line.1];
-        if self.line_no == 1 {
+        if self.at.line_no == 1 {
             line.strip_prefix(BOM).unwrap_or(line)
         } else {
             line
         }
     }
 
-    /// 1-based number of the current line (0 before the first).
+    /// Where it stands.
     #[inline]
-    pub(crate) fn line_no(&self) -> u64 {
-        self.line_no
-    }
-
-    /// Bytes consumed so far.
-    #[inline]
-    pub(crate) fn bytes(&self) -> u64 {
-        self.bytes
-    }
-
-    /// The shared counter mirroring [`Self::bytes`].
-    pub(crate) fn progress(&self) -> Arc<AtomicU64> {
-        Arc::clone(&self.progress)
+    pub(crate) fn at(&self) -> &Position {
+        &self.at
     }
 }
 
@@ -347,7 +342,7 @@ mod tests {
         while r.next_line().expect("in-memory read cannot fail") {
             out.push(r.line().to_vec());
         }
-        assert_eq!(r.bytes(), input.len() as u64);
+        assert_eq!(r.at().bytes, input.len() as u64);
         out
     }
 
@@ -433,7 +428,7 @@ mod tests {
                 got.push(r.line().to_vec());
             }
             assert_eq!(got, expected, "reads of {sizes:?}");
-            assert_eq!(r.bytes(), input.len() as u64);
+            assert_eq!(r.at().bytes, input.len() as u64);
         }
     }
 
@@ -455,7 +450,7 @@ mod tests {
             assert!(r.next_line().expect("first"));
             let second = r.next_line();
             assert_eq!(second.is_ok(), ok, "{len} bytes and {end:?}");
-            assert_eq!(r.line_no(), 2);
+            assert_eq!(r.at().line_no, 2);
             if ok {
                 assert_eq!(r.line().len(), len);
             }

@@ -16,10 +16,10 @@
 //! Memory stays bounded: at most [`BLOCKS`] blocks of [`BLOCK_LINES`] lines wait in
 //! the channel, and emptied blocks go back to the helper to be refilled.
 
-use super::lines::{LineReadError, LineReader, is_skippable};
+use super::lines::{LineReadError, LineReader, Position, is_skippable};
 use std::io::Read;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 /// Lines per block: at 200 Hz about 5 s of a log, some 240 kB.
@@ -78,9 +78,7 @@ pub(crate) struct LinesAhead {
     block: Block,
     /// The current line's entry in `block` (`None` before the first and at the end).
     current: Option<usize>,
-    line_no: u64,
-    bytes: u64,
-    progress: Arc<AtomicU64>,
+    at: Position,
 }
 
 impl LinesAhead {
@@ -90,7 +88,7 @@ impl LinesAhead {
         R: Read + Send + 'static,
         P: Fn(&[u8]) -> Option<Parsed> + Send + 'static,
     {
-        let (line_no, bytes, progress) = (lines.line_no(), lines.bytes(), lines.progress());
+        let at = lines.at().clone();
         let (tx, rx) = sync_channel(BLOCKS);
         // Room for every block there can be: handing one back never blocks.
         let (spare, spare_rx) = sync_channel(BLOCKS + 2);
@@ -105,9 +103,7 @@ impl LinesAhead {
             in_flight,
             block: Block::default(),
             current: None,
-            line_no,
-            bytes,
-            progress,
+            at,
         })
     }
 
@@ -123,9 +119,7 @@ impl LinesAhead {
                 ..Block::default()
             },
             current: None,
-            line_no: 0,
-            bytes: 0,
-            progress: Arc::default(),
+            at: Position::default(),
         }
     }
 
@@ -134,7 +128,7 @@ impl LinesAhead {
         loop {
             let next = self.current.map_or(0, |i| i + 1);
             if let Some(e) = self.block.entries.get(next) {
-                (self.current, self.line_no, self.bytes) = (Some(next), e.line_no, e.bytes);
+                (self.current, self.at.line_no, self.at.bytes) = (Some(next), e.line_no, e.bytes);
                 return Ok(true);
             }
             self.current = None;
@@ -149,7 +143,7 @@ impl LinesAhead {
                     line_no,
                     bytes,
                 }) => {
-                    (self.rx, self.line_no, self.bytes) = (None, line_no, bytes);
+                    (self.rx, self.at.line_no, self.at.bytes) = (None, line_no, bytes);
                     self.block.end = Some(End::Eof);
                     return Err(error);
                 }
@@ -189,21 +183,10 @@ impl LinesAhead {
         self.current.map(|i| &self.block.entries[i])
     }
 
-    /// 1-based number of the current line.
+    /// Where it stands (the helper's byte counter is a little ahead).
     #[inline]
-    pub(crate) fn line_no(&self) -> u64 {
-        self.line_no
-    }
-
-    /// Bytes consumed up to the current line's end.
-    #[inline]
-    pub(crate) fn bytes(&self) -> u64 {
-        self.bytes
-    }
-
-    /// The helper's byte counter (a little ahead of [`Self::bytes`]).
-    pub(crate) fn progress(&self) -> Arc<AtomicU64> {
-        Arc::clone(&self.progress)
+    pub(crate) fn at(&self) -> &Position {
+        &self.at
     }
 }
 
@@ -232,8 +215,8 @@ fn read_all<R: Read>(
                     block.entries.push(Entry {
                         start,
                         end: block.text.len(),
-                        line_no: lines.line_no(),
-                        bytes: lines.bytes(),
+                        line_no: lines.at().line_no,
+                        bytes: lines.at().bytes,
                         parsed: if leave || is_skippable(line) {
                             None
                         } else {
@@ -245,8 +228,8 @@ fn read_all<R: Read>(
                 Err(error) => {
                     block.end = Some(End::Failed {
                         error,
-                        line_no: lines.line_no(),
-                        bytes: lines.bytes(),
+                        line_no: lines.at().line_no,
+                        bytes: lines.at().bytes,
                     });
                 }
             }
@@ -292,24 +275,10 @@ impl<R: Read> Lines<R> {
     }
 
     #[inline]
-    pub(crate) fn line_no(&self) -> u64 {
+    pub(crate) fn at(&self) -> &Position {
         match self {
-            Lines::Here(l) => l.line_no(),
-            Lines::Ahead(l) => l.line_no(),
-        }
-    }
-
-    pub(crate) fn bytes(&self) -> u64 {
-        match self {
-            Lines::Here(l) => l.bytes(),
-            Lines::Ahead(l) => l.bytes(),
-        }
-    }
-
-    pub(crate) fn progress(&self) -> Arc<AtomicU64> {
-        match self {
-            Lines::Here(l) => l.progress(),
-            Lines::Ahead(l) => l.progress(),
+            Lines::Here(l) => l.at(),
+            Lines::Ahead(l) => l.at(),
         }
     }
 }
@@ -327,13 +296,13 @@ mod tests {
             match lines.next_line() {
                 Ok(true) => seen.push((
                     lines.line().to_vec(),
-                    lines.line_no(),
-                    lines.bytes(),
+                    lines.at().line_no,
+                    lines.at().bytes,
                     lines.parsed().copied(),
                 )),
                 Ok(false) => break "end".to_owned(),
-                Err(LineReadError::TooLong) => break format!("too long at {}", lines.line_no()),
-                Err(LineReadError::Io(e)) => break format!("{e} after {}", lines.line_no()),
+                Err(LineReadError::TooLong) => break format!("too long at {}", lines.at().line_no),
+                Err(LineReadError::Io(e)) => break format!("{e} after {}", lines.at().line_no),
             }
         };
         (seen, end)
