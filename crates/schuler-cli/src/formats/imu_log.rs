@@ -85,7 +85,7 @@
 use std::collections::VecDeque;
 use std::fmt;
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -116,11 +116,6 @@ pub const GAP_FACTOR: f64 = 2.0;
 /// Fewest lookahead intervals for the layout check to run; below it the check is
 /// skipped (a median of fewer samples says too little).
 pub const LAYOUT_CHECK_MIN_INTERVALS: usize = 10;
-
-/// Buffer of the `BufReader` [`ImuReader::open`] puts in front of a file [bytes]:
-/// the line reader reads in blocks of 256 KiB, which a small buffer passes through
-/// without a copy.
-pub const READ_BUFFER_BYTES: usize = 1 << 13;
 
 /// Which text format a log is in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -746,8 +741,8 @@ pub struct ImuReader<R> {
     finished: bool,
 }
 
-impl ImuReader<BufReader<File>> {
-    /// Opens the file at `path` (behind a pass-through [`READ_BUFFER_BYTES`] buffer) and reads its
+impl ImuReader<File> {
+    /// Opens the file at `path` (read in large blocks, no `BufReader` needed) and reads its
     /// first samples (see [`ImuReader::new`]).
     pub fn open(path: &Path, options: &ImuReadOptions) -> Result<Self, InputError> {
         let file = File::open(path).map_err(|e| {
@@ -759,15 +754,11 @@ impl ImuReader<BufReader<File>> {
                 format!("cannot open: {e}"),
             )
         })?;
-        Self::new(
-            BufReader::with_capacity(READ_BUFFER_BYTES, file),
-            path,
-            options,
-        )
+        Self::new(file, path, options)
     }
 }
 
-impl<R: BufRead + Send + 'static> ImuReader<R> {
+impl<R: Read + Send + 'static> ImuReader<R> {
     /// The rest of the log read, and its fields parsed, on a helper thread
     /// ([`LinesAhead`]); the samples, errors and gaps are the same, in the same
     /// order, while this reader's checks and conversions run on the thread that
@@ -789,13 +780,12 @@ impl<R: BufRead + Send + 'static> ImuReader<R> {
     }
 }
 
-impl<R: BufRead> ImuReader<R> {
+impl<R: Read> ImuReader<R> {
     /// Wraps `input` (named `path` in errors, e.g. `<stdin>`), reads the CSV header if
     /// any and the first up to [`LOOKAHEAD_INTERVALS`] + 1 samples, fixes the nominal
     /// interval and runs the plausibility check.
     ///
-    /// Standard input needs no `BufReader` of its own (`stdin().lock()` is one): the
-    /// lines are read in large blocks.
+    /// Any reader will do, standard input too: the lines are read in large blocks.
     pub fn new(
         input: R,
         path: impl Into<PathBuf>,
@@ -1309,9 +1299,9 @@ fn check_options(path: &Path, o: &ImuReadOptions) -> Result<(), InputError> {
     Ok(())
 }
 
-impl<R: BufRead> std::iter::FusedIterator for ImuReader<R> {}
+impl<R: Read> std::iter::FusedIterator for ImuReader<R> {}
 
-impl<R: BufRead> Iterator for ImuReader<R> {
+impl<R: Read> Iterator for ImuReader<R> {
     type Item = Result<ImuSample, InputError>;
 
     #[inline]
@@ -1437,7 +1427,7 @@ mod tests {
     }
 
     /// What a reader yields: each sample's bits, or the error's text.
-    fn transcript<R: BufRead>(
+    fn transcript<R: Read>(
         reader: Result<ImuReader<R>, InputError>,
     ) -> Vec<Result<[u64; 8], String>> {
         let reader = match reader {
