@@ -10,7 +10,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::sim::analytic::{self, Maneuvering};
 use schuler_cli::commands::kf_gins::{KfGinsOptions, run};
-use schuler_cli::output::write_imu_text;
+use schuler_io::output::write_imu_text;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 

@@ -15,7 +15,7 @@ use schuler::earth::{Geodetic, Wgs84};
 use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
 use schuler::sim::analytic::{self, Stationary};
-use schuler_cli::output::{ImuDigits, push_imu_line};
+use schuler_io::output::{ImuDigits, push_imu_line};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;

@@ -12,9 +12,9 @@ use schuler::session::FilterConfig;
 use schuler::sim::analytic;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
 use schuler_cli::aided::{Aiding, OutputNames};
-use schuler_cli::formats::ImuReader;
 use schuler_cli::navigate::{NavSettings, navigate};
-use schuler_cli::output::write_imu_text;
+use schuler_io::formats::ImuReader;
+use schuler_io::output::write_imu_text;
 use std::path::PathBuf;
 
 mod common;

@@ -11,11 +11,11 @@ use schuler::earth::{Geodetic, Wgs84};
 use schuler::imu::ImuSample;
 use schuler::sim::analytic::{self, Maneuvering};
 use schuler_cli::aided::AidingOptions;
-use schuler_cli::bag::input::{BagReadOptions, plan};
-use schuler_cli::bag::messages::{Header, Imu, NavSatFix, definitions};
-use schuler_cli::formats::ImuReader;
 use schuler_cli::navigate::{NavSettings, navigate};
 use schuler_cli::options::GradeChoice;
+use schuler_io::bag::input::{BagReadOptions, plan};
+use schuler_io::bag::messages::{Header, Imu, NavSatFix, definitions};
+use schuler_io::formats::ImuReader;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -48,7 +48,7 @@ fn write_gnss_text(path: &Path, fixes: &[(f64, Geodetic)]) {
 }
 
 fn header(t: f64, frame: &str) -> Header {
-    let (sec, nanosec, _) = schuler_cli::bag::output::stamp(t).expect("stamp");
+    let (sec, nanosec, _) = schuler_io::bag::output::stamp(t).expect("stamp");
     Header {
         sec,
         nanosec,
@@ -72,7 +72,7 @@ fn write_bag(path: &Path, samples: &[ImuSample], fixes: &[(f64, Geodetic)]) {
         definitions::nav_sat_fix(),
     );
     let mut put = |channel_id: u16, t: f64, data: Vec<u8>| {
-        let log_time = schuler_cli::bag::output::stamp(t).expect("stamp").2;
+        let log_time = schuler_io::bag::output::stamp(t).expect("stamp").2;
         let h = MessageHeader {
             channel_id,
             sequence: 0,
@@ -120,7 +120,7 @@ fn setup() -> (PathBuf, NavSettings) {
         let samples: Vec<ImuSample> =
             analytic::samples(&Wgs84, &traj, T0 - dt, dt, n + 1).collect();
         let fixes = fixes(&traj);
-        schuler_cli::output::write_imu_text(&dir.join("imu.txt"), samples.iter().copied(), 13)
+        schuler_io::output::write_imu_text(&dir.join("imu.txt"), samples.iter().copied(), 13)
             .expect("imu.txt");
         write_gnss_text(&dir.join("gnss.txt"), &fixes);
         write_bag(&dir.join("drive.mcap"), &samples, &fixes);
@@ -139,7 +139,7 @@ struct Runs {
 impl Runs {
     fn options(
         gnss: Option<PathBuf>,
-        bag: Option<schuler_cli::bag::input::BagAids>,
+        bag: Option<schuler_io::bag::input::BagAids>,
     ) -> AidingOptions {
         AidingOptions {
             gnss,

@@ -378,7 +378,7 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json = serde_json::to_string_pretty(&to_json(a))?;
     let path = dir.join("align.json");
-    crate::line_file::write_whole(&path, json + "\n")?;
+    schuler_io::line_file::write_whole(&path, json + "\n")?;
     let Some(fine) = &a.fine else { return Ok(()) };
     let mut csv = CONVERGENCE_COLUMNS.join(",") + "\n";
     for c in &fine.convergence {
@@ -386,7 +386,7 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
         let _ = writeln!(csv, "{}", row.join(","));
     }
     let path = dir.join("align_convergence.csv");
-    crate::line_file::write_whole(&path, csv)?;
+    schuler_io::line_file::write_whole(&path, csv)?;
     let t: Vec<f64> = fine.convergence.iter().map(|c| c.t - a.t_start).collect();
     let col = |i: usize| -> Vec<f64> {
         fine.convergence

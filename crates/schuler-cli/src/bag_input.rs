@@ -1,18 +1,18 @@
 //! `schuler nav --bag`: a ROS 2 bag as the run's input (its IMU, GNSS, velocity,
-//! barometer and odometry topics, [`crate::bag::input`]) and `--out-bag`, the result as
-//! a bag ([`crate::bag::output`]). The IMU's axes are FLU (REP 103) unless
+//! barometer and odometry topics, [`schuler_io::bag::input`]) and `--out-bag`, the result as
+//! a bag ([`schuler_io::bag::output`]). The IMU's axes are FLU (REP 103) unless
 //! `--imu-axes`/`--imu-rotation` say otherwise; `--imu-time-offset` shifts every
 //! topic's stamps (a bag has one clock); `--gnss-std` and `--gnss-vel-std` stand in
 //! for missing covariances; the IMU's covariances give the noise model where
 //! `--arw`/`--vrw` are not given.
 
-use crate::bag::input::{BagPlan, BagReadOptions, Kind, flu_to_frd, plan};
 use crate::commands::nav::{NavPlan, filter_grade, navigate_samples, print_summary};
 use crate::options::Triple;
 use anyhow::{Result, bail};
 use indicatif::ProgressBar;
 use nalgebra::Vector3;
 use schuler::units::{Dimension, parse_as_or_si};
+use schuler_io::bag::input::{BagPlan, BagReadOptions, Kind, flu_to_frd, plan};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -116,7 +116,7 @@ fn describe(p: &BagPlan) {
     eprintln!(
         "{}: {}",
         p.path.display(),
-        crate::bag::clock::describe(&p.clock)
+        schuler_io::bag::clock::describe(&p.clock)
     );
     for kind in Kind::ALL {
         if let Some(t) = p.topic(kind) {

@@ -9,11 +9,6 @@
 use crate::aided::feed::AidFeed;
 use crate::aided::record::InnovationLog;
 use crate::aided::spilled::Spilled;
-use crate::bag::output::ResultBag;
-use crate::fixed::{Words, put_bytes, put_field};
-use crate::line_file::{LineFile, write_whole};
-use crate::output::{NavEpoch, NavWriter, push_fixed};
-use crate::text_block::{TextBlock, put_first_field};
 use crate::writer_thread::WriterThread;
 use anyhow::Result;
 use nalgebra::Vector3;
@@ -24,6 +19,11 @@ use schuler::filter::smoother::SmoothedTrajectory;
 use schuler::imu::ImuSample;
 use schuler::session::{Epoch, Event, FilterEpoch, Finished, Session, Snapshot};
 use schuler::units::{DEG_PER_H, MGAL, PPM};
+use schuler_io::bag::output::ResultBag;
+use schuler_io::fixed::{Words, put_bytes, put_field};
+use schuler_io::line_file::{LineFile, write_whole};
+use schuler_io::output::{NavEpoch, NavWriter, push_fixed};
+use schuler_io::text_block::{TextBlock, put_first_field};
 use std::path::Path;
 
 /// Text writer for `std.txt` and `imu_err.txt`, through the fast row writer

@@ -10,11 +10,11 @@ use serde::de::DeserializeOwned;
 use toml::Spanned;
 use toml::de::{DeTable, Deserializer};
 
-use crate::formats::ImuReadOptions;
-use crate::formats::imu_columns::{AccelUnit, ColumnSpec, GyroUnit, TimeUnit};
 use crate::options::{FormatChoice, LayoutChoice, Triple, rate};
+use schuler_io::formats::ImuReadOptions;
+use schuler_io::formats::imu_columns::{AccelUnit, ColumnSpec, GyroUnit, TimeUnit};
 
-/// The IMU log's reading options (see [`crate::formats::imu_log`]).
+/// The IMU log's reading options (see [`schuler_io::formats::imu_log`]).
 #[derive(clap::Args, Debug, Default, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImuInputOptions {
@@ -35,13 +35,13 @@ pub struct ImuInputOptions {
     #[arg(long, value_name = "NAMES")]
     pub imu_columns: Option<String>,
     /// Unit of the gyro columns: rad/s or deg/s (rates), rad or deg (increments).
-    #[arg(long, value_enum, value_name = "UNIT")]
+    #[arg(long, value_name = "UNIT", value_parser = crate::options::named::<GyroUnit>())]
     pub gyro_unit: Option<GyroUnit>,
     /// Unit of the accelerometer columns: m/s^2 or g (rates), m/s (increments).
-    #[arg(long, value_enum, value_name = "UNIT")]
+    #[arg(long, value_name = "UNIT", value_parser = crate::options::named::<AccelUnit>())]
     pub accel_unit: Option<AccelUnit>,
     /// Unit of the IMU time column: s, or integer ticks of ms, us, ns.
-    #[arg(long, value_enum, value_name = "UNIT")]
+    #[arg(long, value_name = "UNIT", value_parser = crate::options::named::<TimeUnit>())]
     pub imu_time_unit: Option<TimeUnit>,
     /// Seconds added to the IMU's times after the unit conversion (a clock that starts
     /// at 0 put on the GNSS's time); --start and --end are on the shifted clock.

@@ -8,9 +8,7 @@ use crate::aided::report::{ReportData, RunFacts};
 use crate::aided::spilled::Spilled;
 use crate::aided::{Aiding, OutputNames};
 use crate::drive::{Driven, FilterFiles, Outputs, drive, write_smoothed};
-use crate::formats::ImuReadOptions;
 use crate::options::EarthChoice;
-use crate::output::NavWriter;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Geodetic};
@@ -22,6 +20,8 @@ use schuler::session::{
     Aid, Chosen, Finished, HeadingBank, MechanizationConfig, Session, SessionConfig, SessionError,
     Snapshot, Start, Summary,
 };
+use schuler_io::formats::ImuReadOptions;
+use schuler_io::output::NavWriter;
 use std::path::{Path, PathBuf};
 
 /// Everything a run needs besides its aiding, validated.
@@ -48,7 +48,7 @@ pub struct NavSettings {
     /// The mechanization and its hand-over latitudes.
     pub mechanization: MechanizationConfig,
     /// The result bag to write (`--out-bag`), if any.
-    pub out_bag: Option<crate::bag::output::OutBag>,
+    pub out_bag: Option<schuler_io::bag::output::OutBag>,
 }
 
 impl NavSettings {
@@ -174,7 +174,7 @@ fn outputs<E: EarthModel>(
         outputs = outputs.without_start_epoch();
     }
     if let Some(out_bag) = &settings.out_bag {
-        outputs.bag = Some(crate::bag::output::ResultBag::create(out_bag)?);
+        outputs.bag = Some(schuler_io::bag::output::ResultBag::create(out_bag)?);
     }
     Ok(outputs)
 }

@@ -3,14 +3,28 @@
 //! with units; each parsed from flags and TOML alike. Also the textbook commands' flag
 //! values with units and the textbook sphere (`schuler channel`, `schuler vertical`).
 
-use crate::formats::{ImuFormat, ImuLayout};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use schuler::earth::Sphere;
 use schuler::filter::ImuNoise;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
 use schuler::units::{self, Dimension};
+use schuler_io::formats::{ImuFormat, ImuLayout};
+use schuler_io::named::Named;
 use serde::Deserialize;
+
+/// A flag's parser for a [`Named`] type: its names offered (with their descriptions
+/// in `--help`) and read, as clap's `ValueEnum` does for the option types here.
+pub fn named<T>() -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: Named + Send + Sync + Clone,
+{
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values = T::VALUES
+        .iter()
+        .map(|(_, name, help)| PossibleValue::new(*name).help(*help));
+    PossibleValuesParser::new(values).try_map(|s| T::from_name(&s).ok_or("not a listed value"))
+}
 
 /// Three comma-separated numbers, e.g. `45.07,7.68,245`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]

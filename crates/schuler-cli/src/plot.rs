@@ -158,7 +158,7 @@ impl Plot {
 
     /// Writes the SVG to `path`.
     pub fn write(&self, path: &Path) -> Result<()> {
-        crate::line_file::write_whole(path, self.to_svg())
+        schuler_io::line_file::write_whole(path, self.to_svg())
     }
 
     /// Renders the plot as a standalone SVG document.

@@ -268,7 +268,7 @@ impl Report {
 
     /// Writes the HTML document to `path`.
     pub fn write(&self, path: &Path) -> Result<()> {
-        crate::line_file::write_whole(path, self.to_html())
+        schuler_io::line_file::write_whole(path, self.to_html())
     }
 }
 

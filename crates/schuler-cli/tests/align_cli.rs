@@ -8,7 +8,7 @@ use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
 use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
-use schuler_cli::output::write_imu_text;
+use schuler_io::output::write_imu_text;
 use std::path::{Path, PathBuf};
 
 const TRUE_ATT: [f64; 3] = [1.0, -0.5, 60.0];

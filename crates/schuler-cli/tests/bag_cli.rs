@@ -8,8 +8,8 @@ mod common;
 use common::bag::{data, max_digits_apart, nav_bag, nav_text, simulate_scenario};
 use mcap::records::MessageHeader;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
-use schuler_cli::bag::container::BagStream;
-use schuler_cli::bag::messages::{
+use schuler_io::bag::container::BagStream;
+use schuler_io::bag::messages::{
     Header, IMU, Imu, NAV_SAT_FIX, NavSatFix, Odometry, VECTOR3_STAMPED, definitions,
 };
 use std::collections::BTreeMap;
@@ -728,7 +728,7 @@ fn bag_imus_get_the_text_readers_checks() {
 /// `drive.mcap` copied to `out` with every FluidPressure's variance set to `var_p`
 /// [Pa²] and every Odometry's forward-speed variance to `var_v` [m²/s²].
 fn with_variances(out: &Path, var_p: f64, var_v: f64) {
-    use schuler_cli::bag::messages::{FLUID_PRESSURE, FluidPressure, ODOMETRY};
+    use schuler_io::bag::messages::{FLUID_PRESSURE, FluidPressure, ODOMETRY};
     let file = std::fs::File::create(out).expect("bag");
     let mut w = mcap::Writer::new(std::io::BufWriter::new(file)).expect("writer");
     let mut channels: BTreeMap<usize, u16> = BTreeMap::new();

@@ -25,8 +25,8 @@ use schuler::imu::ImuSample;
 use schuler::nav::NavState;
 use schuler::rotation::Euler;
 use schuler::session::{Aid, Epoch, FilterConfig, Session, SessionConfig, Start};
-use schuler_cli::formats::gnss::{GnssReadOptions, read_baro, read_gnss_log};
-use schuler_cli::formats::{ImuReadOptions, ImuReader, nav, nmea, rtklib, sensor_errors, vehicle};
+use schuler_io::formats::gnss::{GnssReadOptions, read_baro, read_gnss_log};
+use schuler_io::formats::{ImuReadOptions, ImuReader, nav, nmea, rtklib, sensor_errors, vehicle};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 

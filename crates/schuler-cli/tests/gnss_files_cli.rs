@@ -129,7 +129,7 @@ fn the_simulators_csv_navigates_as_its_text_twin() {
     assert_same_outputs(&from_txt, &from_csv);
 
     // The outlier is the simulator's truth: nav did not drop it, the gate refused it.
-    let records = schuler_cli::formats::gnss::read_gnss_records(&csv).expect("reads");
+    let records = schuler_io::formats::gnss::read_gnss_records(&csv).expect("reads");
     let flagged: Vec<f64> = records
         .iter()
         .filter(|r| r.outlier == Some(true))

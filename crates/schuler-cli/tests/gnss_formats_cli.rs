@@ -12,9 +12,7 @@ mod common;
 use chrono::{Datelike, NaiveDate, Timelike};
 use nalgebra::{Matrix3, Vector3};
 use schuler::earth::{EarthModel, Geodetic, Wgs84, c_ne};
-use schuler_cli::formats::gnss::{
-    GnssFormat, GnssLog, GnssQuality, GnssReadOptions, read_gnss_log,
-};
+use schuler_io::formats::gnss::{GnssFormat, GnssLog, GnssQuality, GnssReadOptions, read_gnss_log};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 

@@ -12,8 +12,8 @@ use std::ffi::OsStr;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use schuler_cli::formats::ImuReader;
 use schuler_cli::imu_input::ImuInputOptions;
+use schuler_io::formats::ImuReader;
 
 /// The runs stop here [s]: the rest, the turn, the climb and the GNSS outage.
 const END: f64 = 600.0;
@@ -346,8 +346,8 @@ fn a_real_device_reads_with_its_flags() {
     let file = common::test_data("airbrakes_3dm_cx5").join("zminus_rest.csv");
     let options = ImuInputOptions {
         imu_columns: Some("_,_,t,_,fx,fy,fz,wx,wy,wz,...".into()),
-        accel_unit: Some(schuler_cli::formats::imu_columns::AccelUnit::G),
-        imu_time_unit: Some(schuler_cli::formats::imu_columns::TimeUnit::Ns),
+        accel_unit: Some(schuler_io::formats::imu_columns::AccelUnit::G),
+        imu_time_unit: Some(schuler_io::formats::imu_columns::TimeUnit::Ns),
         imu_time_offset: Some(-1_730_147_509.0),
         ..Default::default()
     };

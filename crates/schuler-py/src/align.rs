@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 use schuler::align::Alignment;
 use schuler_cli::alignment::{align_on, convergence_row, read_stage, summary_text, to_json};
 use schuler_cli::commands::align::{Args, setup};
-use schuler_cli::formats::ImuReader;
+use schuler_io::formats::ImuReader;
 
 /// `schuler align`'s arguments.
 #[derive(Parser, Debug)]

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use schuler::analysis::allan::{CurveOptions, ImuAllan};
 use schuler::imu::ImuSample;
-use schuler_cli::formats::ImuReader;
+use schuler_io::formats::ImuReader;
 use std::path::PathBuf;
 
 /// Columns: cluster time, cluster size, the deviations of the gyros [rad/s] and the

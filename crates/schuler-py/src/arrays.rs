@@ -8,9 +8,9 @@ use numpy::ndarray::ArrayView1;
 use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
 use schuler::imu::ImuSample;
-use schuler_cli::formats::InputError;
-use schuler_cli::formats::error::InputErrorKind;
-use schuler_cli::formats::vehicle::Rows;
+use schuler_io::formats::InputError;
+use schuler_io::formats::error::InputErrorKind;
+use schuler_io::formats::vehicle::Rows;
 use std::path::Path;
 
 /// Name of the IMU arrays in errors.
@@ -188,7 +188,7 @@ pub fn gnss_fixes(cols: &[ArrayView1<'_, f64>]) -> Result<Vec<GnssFix>, InputErr
 
 /// Numbered rows of `cols` named `names` (as many columns as one of `counts`, of equal
 /// lengths, every value finite, the first column's times increasing), row `i` as line
-/// `i + 1`: the rows a log's file reader gives ([`schuler_cli::formats::vehicle::Rows`]).
+/// `i + 1`: the rows a log's file reader gives ([`schuler_io::formats::vehicle::Rows`]).
 pub fn rows(
     what: &str,
     names: &[&str],

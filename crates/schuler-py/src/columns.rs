@@ -55,7 +55,7 @@ impl Columns {
     }
 }
 
-/// Columns of a navigation result: time and [`schuler_cli::output::nav_fields`].
+/// Columns of a navigation result: time and [`schuler_io::output::nav_fields`].
 pub const NAV: &[&str] = &[
     "t_s",
     "lat_deg",

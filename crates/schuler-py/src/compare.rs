@@ -11,8 +11,8 @@ use schuler::analysis::errors::NavRecord;
 use schuler::earth::Geodetic;
 use schuler::rotation::Euler;
 use schuler_cli::commands::compare::summary_json;
-use schuler_cli::formats::nav::{NavFormat, read_nav};
-use schuler_cli::output::error_fields;
+use schuler_io::formats::nav::{NavFormat, read_nav};
+use schuler_io::output::error_fields;
 use std::path::{Path, PathBuf};
 
 /// Columns of the errors (`errors.csv`'s, units in the names).

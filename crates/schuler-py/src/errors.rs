@@ -4,7 +4,7 @@
 
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use schuler_cli::formats::InputError as ReadError;
+use schuler_io::formats::InputError as ReadError;
 
 pyo3::create_exception!(
     _schuler,

@@ -115,7 +115,7 @@ fn navigate<'py>(
             match &views {
                 Some(v) => run::run(&mut plan, &mut tables, v.samples(read.t_start, read.t_end)?),
                 None => {
-                    let reader = schuler_cli::formats::ImuReader::open(&path, &read)?;
+                    let reader = schuler_io::formats::ImuReader::open(&path, &read)?;
                     run::run(&mut plan, &mut tables, reader)
                 }
             }

@@ -36,7 +36,7 @@ pub fn nav_args(flags: &[String]) -> Result<NavArgs> {
 }
 
 /// The IMU reader's options and time window from `flags`.
-pub fn imu_options(flags: &[String]) -> Result<schuler_cli::formats::ImuReadOptions> {
+pub fn imu_options(flags: &[String]) -> Result<schuler_io::formats::ImuReadOptions> {
     let f = ImuFlags::try_parse_from(flags)?;
     f.input.read_options(f.start, f.end)
 }

@@ -6,7 +6,7 @@ use crate::columns::{Columns, GNSS, IMU, NAV};
 use crate::errors::IntoPy;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use schuler_cli::formats::ImuReader;
+use schuler_io::formats::ImuReader;
 use std::path::PathBuf;
 
 /// IMU samples of `path` as the CLI reads them with `flags` (the IMU input flags,
@@ -92,7 +92,7 @@ fn degrees_back(rad: f64) -> f64 {
 #[pyfunction]
 pub fn read_baro<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let rows = py
-        .detach(|| schuler_cli::formats::gnss::read_baro(&path))
+        .detach(|| schuler_io::formats::gnss::read_baro(&path))
         .py_err(py)?;
     let d = PyDict::new(py);
     d.set_item("t_s", rows.iter().map(|r| r.0).collect::<Vec<_>>())?;
@@ -105,7 +105,7 @@ pub fn read_baro<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyD
 #[pyfunction]
 pub fn read_nav<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let (_, rows) = py
-        .detach(|| schuler_cli::formats::nav::read_nav(&path))
+        .detach(|| schuler_io::formats::nav::read_nav(&path))
         .py_err(py)?;
     let mut c = Columns::new(NAV);
     for r in &rows {

@@ -25,10 +25,10 @@ use schuler_cli::commands::nav::{
     resolve_aiding,
 };
 use schuler_cli::drive::{Refusal, imu_err_row, std_row};
-use schuler_cli::formats::InputError;
 use schuler_cli::navigate::{NavSettings, decide_heading, open_session};
 use schuler_cli::options::EarthChoice;
-use schuler_cli::output::nav_fields;
+use schuler_io::formats::InputError;
+use schuler_io::output::nav_fields;
 
 /// The settings and aiding of a run, from the CLI's flags.
 pub struct Plan {

@@ -36,7 +36,7 @@ impl PySession {
 
     fn push_samples(
         &mut self,
-        samples: impl Iterator<Item = Result<ImuSample, schuler_cli::formats::InputError>>,
+        samples: impl Iterator<Item = Result<ImuSample, schuler_io::formats::InputError>>,
     ) -> anyhow::Result<()> {
         let mut last = self.last_t;
         let (session, tables) = self.open()?;

@@ -15,7 +15,7 @@ use schuler::sim::analytic::Kinematics;
 use schuler::sim::receivers::{BaroReading, GnssFix};
 use schuler::sim::run::{ImuErrorTruth, ScenarioSpec, SimSink, simulate};
 use schuler_cli::drive::imu_err_row;
-use schuler_cli::output::nav_fields;
+use schuler_io::output::nav_fields;
 use std::path::Path;
 
 /// Columns of the truth after [`NAV`]'s: angular rate [rad/s] and specific force

@@ -1,15 +1,15 @@
 //! The vehicle aids from numpy columns: rest intervals, odometer speeds and
 //! dual-antenna headings, with the CLI's columns and units (the files of `--zupt`,
 //! `--odometer`, `--dual-antenna`), checked and converted by the CLI readers' own code
-//! ([`schuler_cli::formats::vehicle`]); errors name the array, the 1-based row and the
+//! ([`schuler_io::formats::vehicle`]); errors name the array, the 1-based row and the
 //! column.
 
 use crate::arrays::rows;
 use numpy::ndarray::ArrayView1;
 use schuler::filter::HeadingReading;
 use schuler_cli::aided::vehicle::GivenVehicle;
-use schuler_cli::formats::InputError;
-use schuler_cli::formats::vehicle::{heading_readings, odometer_readings, rest_intervals};
+use schuler_io::formats::InputError;
+use schuler_io::formats::vehicle::{heading_readings, odometer_readings, rest_intervals};
 use std::path::Path;
 
 /// Columns of rest intervals: start and end [s].

@@ -17,11 +17,11 @@
 //! finds the epochs around its time, as it found them in the whole truth.
 
 use super::Aiding;
-use crate::formats::nav::NavReader;
 use anyhow::Result;
 use schuler::earth::EarthModel;
 use schuler::imu::ImuSample;
 use schuler::session::{Aid, Session, SessionError};
+use schuler_io::formats::nav::NavReader;
 use std::iter::Peekable;
 
 /// One kind's aids, in time order.

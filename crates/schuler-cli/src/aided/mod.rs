@@ -12,7 +12,6 @@ pub mod series;
 pub mod spilled;
 pub mod vehicle;
 
-use crate::formats::gnss::{GnssFormat, GnssQuality, GnssReadOptions, read_gnss_log};
 use crate::options::{Triple, quantity};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
@@ -20,6 +19,7 @@ use report::ReportSettings;
 use schuler::filter::{GnssFix, ImuNoise, IntegrationConfig, SensorEstimates};
 use schuler::session::{ErrorModelChoice, FilterConfig};
 use schuler::units::{Dimension, parse_as_or_si};
+use schuler_io::formats::gnss::{GnssFormat, GnssQuality, GnssReadOptions, read_gnss_log};
 use std::path::{Path, PathBuf};
 use vehicle::VehicleReadings;
 
@@ -131,7 +131,7 @@ pub struct AidingOptions {
     pub gnss: Option<PathBuf>,
     /// Format of --gnss (default auto: NMEA sentences, an RTKLIB `%` column header, else
     /// text).
-    #[arg(long, value_name = "FORMAT")]
+    #[arg(long, value_name = "FORMAT", value_parser = crate::options::named::<GnssFormat>())]
     pub gnss_format: Option<GnssFormat>,
     /// Position standard deviations north, east, down [m] for GNSS fixes whose file
     /// gives none (4-column text, CSV without std columns, NMEA without GST, RTKLIB
@@ -140,7 +140,7 @@ pub struct AidingOptions {
     pub gnss_std: Option<Triple>,
     /// Drop NMEA and RTKLIB fixes of a lower quality: single (default, all kept),
     /// dgps, float (PPP too) or fix.
-    #[arg(long, value_name = "QUALITY")]
+    #[arg(long, value_name = "QUALITY", value_parser = crate::options::named::<GnssQuality>())]
     pub gnss_min_quality: Option<GnssQuality>,
     /// Added to every GNSS time after reading (e.g. `-18 s` to put GPS seconds of week
     /// onto an IMU clock in UTC; NMEA and RTKLIB times are GPS seconds of week, NMEA
@@ -344,7 +344,7 @@ pub struct AidingOptions {
     /// is given.
     #[arg(skip)]
     #[serde(skip)]
-    pub bag: Option<crate::bag::input::BagAids>,
+    pub bag: Option<schuler_io::bag::input::BagAids>,
 }
 
 impl AidingOptions {
@@ -538,10 +538,10 @@ impl AidingOptions {
         {
             let vel_std = self.gnss_vel_std()?;
             let opts = self.gnss_read_options(vel_std)?;
-            if crate::formats::gnss::format_of(path, opts.format)? == GnssFormat::Text {
+            if schuler_io::formats::gnss::format_of(path, opts.format)? == GnssFormat::Text {
                 let offset = self.gnss_time_offset()?;
                 let mut store = fixes::Fixes::default();
-                crate::formats::gnss::for_each_text_record(path, opts.default_std, |r| {
+                schuler_io::formats::gnss::for_each_text_record(path, opts.default_std, |r| {
                     let mut fix = r.fix;
                     if let Some(dt) = offset {
                         fix.t += dt;
@@ -600,7 +600,7 @@ impl AidingOptions {
                 .unwrap_or_default(),
         };
         if let Some(v) = &self.gnss_vel {
-            let unmatched = crate::formats::gnss::merge_velocity(&mut fixes, v, vel_std)?;
+            let unmatched = schuler_io::formats::gnss::merge_velocity(&mut fixes, v, vel_std)?;
             if unmatched > 0 {
                 eprintln!(
                     "warning: {}: {unmatched} velocity epochs have no position fix at the same time and are not used",
@@ -759,7 +759,7 @@ impl AidingOptions {
     fn baro(&self, given: Option<Vec<(f64, f64)>>) -> Result<BaroInput> {
         let readings = match (given, &self.baro, &self.bag) {
             (Some(given), _, _) => given,
-            (None, Some(path), _) => crate::formats::gnss::read_baro(path)?,
+            (None, Some(path), _) => schuler_io::formats::gnss::read_baro(path)?,
             (None, None, Some(bag)) if !bag.baro.is_empty() => bag.baro.clone(),
             _ => return Ok((Vec::new(), None)),
         };
@@ -840,7 +840,7 @@ impl AidingOptions {
             html: !self.no_report,
             truth: self.truth.as_deref().map(report::Truth::file).transpose()?,
             sensor_truth: match &self.sensor_truth {
-                Some(p) => crate::formats::sensor_errors::read_sensor_errors(p)?,
+                Some(p) => schuler_io::formats::sensor_errors::read_sensor_errors(p)?,
                 None => Vec::new(),
             },
         })
@@ -866,8 +866,8 @@ pub fn report_outage_test(
         println!("  (give --truth FILE for the errors in each outage)");
         return Ok(());
     };
-    let (_, nav_rows) = crate::formats::nav::read_nav(nav)?;
-    let (_, truth_rows) = crate::formats::nav::read_nav(truth)?;
+    let (_, nav_rows) = schuler_io::formats::nav::read_nav(nav)?;
+    let (_, truth_rows) = schuler_io::formats::nav::read_nav(truth)?;
     let c = schuler::analysis::statistics::compare(&nav_rows, &truth_rows, None, None, windows)?;
     let mut json = Vec::new();
     println!(
@@ -910,7 +910,7 @@ pub fn report_outage_test(
     let text = serde_json::to_string_pretty(
         &serde_json::json!({ "outages": json, "rms_of_maxima": rms }),
     )?;
-    crate::line_file::write_whole(&path, text + "\n")
+    schuler_io::line_file::write_whole(&path, text + "\n")
 }
 
 #[cfg(test)]

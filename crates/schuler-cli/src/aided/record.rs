@@ -19,11 +19,11 @@
 //! the report of a long run costs no more memory than a short one's.
 
 use super::spilled::{Record, Spilled};
-use crate::line_file::LineWriter;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
 use schuler::filter::integration::Innovation;
 use schuler::filter::measurement::Kind;
+use schuler_io::line_file::LineWriter;
 use std::io::Write;
 use std::path::Path;
 

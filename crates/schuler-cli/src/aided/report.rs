@@ -85,7 +85,7 @@ pub struct Truth {
 impl Truth {
     /// A truth file, read as the run goes (checked through now).
     pub fn file(path: &Path) -> Result<Self> {
-        crate::formats::nav::check_nav(path)?;
+        schuler_io::formats::nav::check_nav(path)?;
         Ok(Self {
             path: path.to_path_buf(),
             held: None,
@@ -96,7 +96,7 @@ impl Truth {
     pub fn records(&self) -> Result<Vec<NavRecord>> {
         match &self.held {
             Some(rows) => Ok(rows.clone()),
-            None => Ok(crate::formats::nav::read_nav(&self.path)?.1),
+            None => Ok(schuler_io::formats::nav::read_nav(&self.path)?.1),
         }
     }
 }
@@ -390,7 +390,7 @@ fn write_csv(
     rows: impl Iterator<Item = Vec<Option<f64>>>,
 ) -> Result<()> {
     use std::io::Write as _;
-    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(path)?;
     let mut s = String::with_capacity(1 << 10);
     writeln!(w, "{header}").with_context(|| format!("cannot write {}", path.display()))?;
     for row in rows {
@@ -433,7 +433,7 @@ pub fn write(out: &Path, html: bool, data: &ReportData) -> Result<String> {
     data.samples.status()?;
     let path = out.join("consistency.json");
     let text = serde_json::to_string_pretty(&consistency_json(&nis, nees.as_ref()))?;
-    crate::line_file::write_whole(&path, text + "\n")?;
+    schuler_io::line_file::write_whole(&path, text + "\n")?;
     let mut printed = consistency_text(&nis, nees.as_ref());
     if html {
         let ctx = Ctx {
@@ -626,7 +626,7 @@ fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
         return Ok(());
     };
     let truth_path = &truth.path;
-    let (_, nav) = crate::formats::nav::read_nav(data.facts.nav_file)?;
+    let (_, nav) = schuler_io::formats::nav::read_nav(data.facts.nav_file)?;
     let truth = truth.records()?;
     let cmp: Comparison = compare(&nav, &truth, None, None, &c.gaps).with_context(|| {
         format!(
@@ -640,7 +640,7 @@ fn position_section(r: &mut Report, c: &Ctx) -> Result<()> {
     if let Some(t) = gap_table(c, &cmp) {
         s.table(t);
     }
-    crate::output::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
+    schuler_io::output::write_errors_csv(&c.dir.join("errors.csv"), &cmp.errors)?;
     let plot = position_plot(c, &cmp);
     let svg = c.svg("position_error", &plot)?;
     s.plot_with_files(&plot, &[&svg, "report/errors.csv"]);

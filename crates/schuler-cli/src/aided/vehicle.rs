@@ -162,7 +162,7 @@ fn rest_config(
             RestSource::Intervals
         }
         (None, Some(path), _) => {
-            *rests = crate::formats::vehicle::read_rest_intervals(path)?;
+            *rests = schuler_io::formats::vehicle::read_rest_intervals(path)?;
             RestSource::Intervals
         }
         (None, None, true) => RestSource::Detect {
@@ -214,7 +214,7 @@ fn odometer(
         (given, path, bag) => {
             *readings = match (given, path, bag) {
                 (Some(given), _, _) => given,
-                (None, Some(path), _) => crate::formats::vehicle::read_odometer(path)?,
+                (None, Some(path), _) => schuler_io::formats::vehicle::read_odometer(path)?,
                 (None, None, bag) => bag.cloned().unwrap_or_default(),
             };
             Some(positive(
@@ -267,7 +267,7 @@ fn heading_baseline(
     }
     *headings = match (given, &o.dual_antenna) {
         (Some(given), _) => given,
-        (None, Some(path)) => crate::formats::vehicle::read_heading(path)?,
+        (None, Some(path)) => schuler_io::formats::vehicle::read_heading(path)?,
         (None, None) => Vec::new(),
     };
     Ok(Some(baseline))
@@ -354,8 +354,14 @@ pub fn summary(c: &Counts) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::formats::temp_file;
     use crate::options::GradeChoice;
+
+    /// A temporary file holding `text`.
+    fn temp_file(text: &str) -> tempfile::NamedTempFile {
+        let f = tempfile::NamedTempFile::new().expect("temp");
+        std::fs::write(f.path(), text).expect("write");
+        f
+    }
 
     /// Readings given in memory set the aids up as their files do: the same session
     /// configuration and the same readings pushed.
@@ -380,7 +386,7 @@ mod tests {
             ..tuning.clone()
         };
         let read = resolve(&files, &noise, GivenVehicle::default()).expect("files");
-        let v = crate::formats::vehicle::read_heading(heading.path()).expect("headings");
+        let v = schuler_io::formats::vehicle::read_heading(heading.path()).expect("headings");
         let given = GivenVehicle {
             rests: Some(vec![(0.0, 60.0), (100.5, 130.0)]),
             odometer: Some(vec![(60.1, 0.5), (60.2, -0.25)]),

@@ -100,7 +100,7 @@ impl CampaignConfig {
 
     /// The configuration in the file `path`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::formats::read_config_text(path)?;
+        let text = schuler_io::formats::read_config_text(path)?;
         let dir = path.parent().unwrap_or(Path::new(""));
         Self::from_toml(&text, dir, &path.display().to_string())
     }

@@ -4,13 +4,13 @@
 //! `schuler nav --align` ([`crate::alignment`]).
 
 use crate::alignment::{AlignOptions, align_on, read_stage, summary_text, write_outputs};
-use crate::formats::ImuReader;
 use crate::imu_input::ImuInputOptions;
 use crate::options::{EarthChoice, Triple};
 use anyhow::{Context, Result, bail};
 use schuler::align::AlignConfig;
 use schuler::earth::Geodetic;
 use schuler::filter::ImuNoise;
+use schuler_io::formats::ImuReader;
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -20,7 +20,6 @@
 //! their median; otherwise the curve measures the motion and a warning names the
 //! file.
 
-use crate::formats::ImuReader;
 use crate::imu_input::ImuInputOptions;
 use crate::options::quantity;
 use crate::plot::{LineStyle, Plot};
@@ -35,6 +34,7 @@ use schuler::analysis::allan::{AllanCurve, CHANNEL_NAMES, CurveOptions, ImuAllan
 use schuler::earth::Wgs84;
 use schuler::imu::ImuSample;
 use schuler::units::{DEG, Dimension, G0, Unit};
+use schuler_io::formats::ImuReader;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -683,7 +683,7 @@ pub fn noise_toml(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String 
 /// Writes `text` to `dir/name`.
 fn write(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
     let path = dir.join(name);
-    crate::line_file::write_whole(&path, text)?;
+    schuler_io::line_file::write_whole(&path, text)?;
     Ok(path)
 }
 

@@ -2,9 +2,9 @@
 //! directory) with their types, message counts, rates and log-time spans, and which
 //! of them `schuler nav --bag` would read.
 
-use crate::bag::info::{scan, table};
-use crate::bag::input::Kind;
 use anyhow::Result;
+use schuler_io::bag::info::{scan, table};
+use schuler_io::bag::input::Kind;
 use std::path::PathBuf;
 
 /// Arguments of `schuler bag`.

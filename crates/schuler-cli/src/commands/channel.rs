@@ -321,7 +321,7 @@ pub fn run(args: Args) -> Result<()> {
     write_errors_csv(&args.out.join("errors.csv"), &result)?;
     let summary = summary(&cfg, &result);
     let text = serde_json::to_string_pretty(&summary).context("encoding summary.json")?;
-    crate::line_file::write_whole(&args.out.join("summary.json"), text + "\n")?;
+    schuler_io::line_file::write_whole(&args.out.join("summary.json"), text + "\n")?;
     write_plots(&args.out, &cfg, &result)?;
     let period = summary["schuler_period_s"]["measured"].as_f64();
     let mut line = format!(
@@ -341,7 +341,7 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Writes `errors.csv`.
 fn write_errors_csv(path: &Path, run: &ChannelRun) -> Result<()> {
-    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(path)?;
     let mut line = String::with_capacity(256);
     writeln!(
         w,

@@ -2,16 +2,16 @@
 //! errors of any navigation result (schuler's, KF-GINS's, another tool's) against a
 //! truth file, as a table, `compare.json`, `errors.csv` and SVG plots.
 //!
-//! The file formats are [`crate::formats::nav`]'s; the matching, the errors and the
+//! The file formats are [`schuler_io::formats::nav`]'s; the matching, the errors and the
 //! statistics are the library's ([`schuler::analysis::errors`],
 //! [`schuler::analysis::statistics`]), shared with the aided run's report.
 
-use crate::formats::nav::{NavFormat, read_nav};
-use crate::output::write_errors_csv;
 use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result};
 use schuler::analysis::errors::EpochErrors;
 use schuler::analysis::statistics::{Comparison, OutageMax, QUANTITIES, Quantity, compare};
+use schuler_io::formats::nav::{NavFormat, read_nav};
+use schuler_io::output::write_errors_csv;
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -313,7 +313,7 @@ pub fn run(args: Args) -> Result<()> {
         let json = summary_json(&c, (&args.nav, nav_format), (&args.truth, truth_format));
         let text = serde_json::to_string_pretty(&json).context("encoding compare.json")?;
         let path = dir.join("compare.json");
-        crate::line_file::write_whole(&path, text + "\n")?;
+        schuler_io::line_file::write_whole(&path, text + "\n")?;
         write_errors_csv(&dir.join("errors.csv"), &c.errors)?;
         write_plots(dir, &c)?;
         println!(

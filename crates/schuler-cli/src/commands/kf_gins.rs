@@ -16,7 +16,6 @@
 
 use crate::aided::report::ReportSettings;
 use crate::aided::{Aiding, OutputNames};
-use crate::formats::{ImuFormat, ImuLayout, ImuReadOptions};
 use crate::navigate::{NavSettings, navigate};
 use crate::options::{EarthChoice, GravityChoice};
 use anyhow::{Context, Result, bail};
@@ -28,6 +27,7 @@ use schuler::filter::{Gate, IntegrationConfig};
 use schuler::rotation::Euler;
 use schuler::session::{FilterConfig, MechanizationChoice, MechanizationConfig, Start};
 use schuler::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MGAL, PPM};
+use schuler_io::formats::{ImuFormat, ImuLayout, ImuReadOptions};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -306,7 +306,7 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
     // configured state, not a fix). The log is streamed into the store (memory
     // bounded whatever its length); it must give standard deviations.
     let mut fixes = crate::aided::fixes::Fixes::default();
-    crate::formats::gnss::for_each_text_record(&y.gnsspath, None, |r| {
+    schuler_io::formats::gnss::for_each_text_record(&y.gnsspath, None, |r| {
         if r.fix.t > y.starttime && (y.endtime < 0.0 || r.fix.t <= y.endtime) {
             fixes.push(&r.fix);
         }
@@ -386,7 +386,7 @@ pub fn run(path: &Path, opts: &KfGinsOptions) -> Result<()> {
         aiding,
         gravity,
     } = load(path, opts)?;
-    let reader = crate::formats::ImuReader::open(&settings.imu, &settings.read)?;
+    let reader = schuler_io::formats::ImuReader::open(&settings.imu, &settings.read)?;
     // Read and parsed on a second thread, overlapping the navigation; the samples
     // come in the same order, so the files are the same bytes.
     let mut reader = reader.read_ahead()?;

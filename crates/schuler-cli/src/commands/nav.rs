@@ -17,7 +17,6 @@
 use crate::aided::{Aiding, AidingOptions, GivenReadings};
 use crate::alignment::AlignOptions;
 use crate::bag_input::BagArgs;
-use crate::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use crate::imu_input::ImuInputOptions;
 use crate::navigate::{NavSettings, RunSummary, navigate};
 use crate::options::{EarthChoice, GradeChoice, GravityChoice, MechanizationChoice, Triple, rate};
@@ -28,6 +27,7 @@ use schuler::earth::{Geodetic, Sphere, Wgs84, Wgs84Series};
 use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
 use schuler::session::{MechanizationConfig, Prior, Start};
+use schuler_io::formats::{ImuFormat, ImuReadOptions, ImuReader};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -175,7 +175,7 @@ pub enum InitChoice {
 }
 
 fn load_config(path: &Path) -> Result<NavConfig> {
-    let text = crate::formats::read_config_text(path)?;
+    let text = schuler_io::formats::read_config_text(path)?;
     let (mut cfg, input): (NavConfig, _) =
         ImuInputOptions::split_config(&text).with_context(|| format!("in {}", path.display()))?;
     cfg.input = input;
@@ -259,7 +259,7 @@ fn init_pos(args: &NavArgs, cfg: &NavConfig) -> Result<Geodetic> {
         .init_pos
         .or(cfg.init_pos)
         .context("no initial position: give --init-pos LAT,LON,H (deg, deg, m)")?;
-    crate::formats::gnss::position_in_domain(lat, lon, h)
+    schuler_io::formats::gnss::position_in_domain(lat, lon, h)
         .map_err(|(_, e)| anyhow!("--init-pos: {e}"))
 }
 
@@ -355,10 +355,13 @@ fn plan(args: NavArgs) -> Result<NavPlan> {
             .map_err(anyhow::Error::msg)?,
         week: args.week.or(cfg.week).unwrap_or(0),
         mechanization: mechanization_config(&args, &cfg)?,
-        out_bag: bag.out_bag.clone().map(|path| crate::bag::output::OutBag {
-            path,
-            clock: Default::default(),
-        }),
+        out_bag: bag
+            .out_bag
+            .clone()
+            .map(|path| schuler_io::bag::output::OutBag {
+                path,
+                clock: Default::default(),
+            }),
     };
     let alignment = args
         .alignment

@@ -163,7 +163,7 @@ pub struct Config {
 
 /// Reads and checks a config; errors name the key.
 pub fn load(path: &Path) -> Result<Config> {
-    let text = crate::formats::read_config_text(path)?;
+    let text = schuler_io::formats::read_config_text(path)?;
     let spec: ConfigSpec =
         toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
     parse(spec).with_context(|| format!("in {}", path.display()))
@@ -412,7 +412,7 @@ pub fn run(args: Args) -> Result<()> {
 }
 
 fn write_file(path: &Path, text: &str) -> Result<()> {
-    crate::line_file::write_whole(path, text)
+    schuler_io::line_file::write_whole(path, text)
 }
 
 /// The epoch of the table: 1 h after the start, or the last one of a shorter run.
@@ -426,7 +426,7 @@ fn table_epoch(c: &Comparison) -> usize {
 
 /// Writes `errors.csv`.
 fn write_errors_csv(path: &Path, c: &Comparison) -> Result<()> {
-    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(path)?;
     let mut line = String::from("t");
     for s in &c.systems {
         for q in [

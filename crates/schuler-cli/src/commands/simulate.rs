@@ -31,13 +31,13 @@
 //! bytes.
 
 use crate::drive::{imu_err_row, push_table_row};
-use crate::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
-use crate::line_file::LineFile;
-use crate::output::{push_nav_fields, put_imu_increments, put_nav_fields};
-use crate::text_block::{TextBlock, window};
 use anyhow::{Context, Result};
 use schuler::sim::receivers::GnssFix;
 use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
+use schuler_io::fixed::{Line, Twin, Words, push_fixed, put_bytes, put_field};
+use schuler_io::line_file::LineFile;
+use schuler_io::output::{push_nav_fields, put_imu_increments, put_nav_fields};
+use schuler_io::text_block::{TextBlock, window};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -398,7 +398,7 @@ impl Files {
 /// Read and parse a scenario file, and the gnss-ins-sim motion file it names (a path
 /// relative to the scenario's folder).
 pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
-    let text = crate::formats::read_config_text(path)?;
+    let text = schuler_io::formats::read_config_text(path)?;
     let spec: ScenarioSpec =
         toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
     with_motion_csv(spec, path.parent().unwrap_or(Path::new("")))
@@ -408,8 +408,8 @@ pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
 pub fn with_motion_csv(mut spec: ScenarioSpec, dir: &Path) -> Result<ScenarioSpec> {
     if let Some(csv) = &spec.motion_csv {
         let csv_path = dir.join(csv);
-        let text =
-            String::from_utf8_lossy(&crate::formats::read_lines_whole(&csv_path)?).into_owned();
+        let text = String::from_utf8_lossy(&schuler_io::formats::read_lines_whole(&csv_path)?)
+            .into_owned();
         let def = schuler::sim::gnss_ins_sim::parse(&text)
             .with_context(|| format!("in {}", csv_path.display()))?;
         spec.imported = Some(def);
@@ -451,7 +451,7 @@ pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::
     let resolved =
         toml::to_string(&spec.resolved()).context("cannot serialize the resolved scenario")?;
     let path = dir.join("scenario.resolved.toml");
-    crate::line_file::write_whole(&path, resolved)?;
+    schuler_io::line_file::write_whole(&path, resolved)?;
     Ok(summary)
 }
 
@@ -480,13 +480,13 @@ pub fn run(args: Args) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::{ImuDigits, push_imu_line};
     use nalgebra::Vector3;
     use schuler::earth::Geodetic;
     use schuler::imu::ImuSample;
     use schuler::nav::NavState;
     use schuler::rotation::Euler;
     use schuler::sim::analytic::Kinematics;
+    use schuler_io::output::{ImuDigits, push_imu_line};
 
     /// The text writers before the fixed-size windows (commit 97e21d9), kept as the
     /// oracle: every line through the Vec writers, the CSV as the text with commas.

@@ -238,7 +238,7 @@ pub fn run(args: Args) -> Result<()> {
         ModeChoice::Aided => run_aided(&cfg, &args)?,
     };
     let text = serde_json::to_string_pretty(&summary).context("encoding summary.json")?;
-    crate::line_file::write_whole(&args.out.join("summary.json"), text + "\n")?;
+    schuler_io::line_file::write_whole(&args.out.join("summary.json"), text + "\n")?;
     println!(
         "schuler vertical ({}): wrote {}",
         summary["mode"].as_str().unwrap_or("?"),
@@ -249,7 +249,7 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Writes `vertical.csv`.
 fn write_samples(path: &Path, samples: &[VerticalSample]) -> Result<()> {
-    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(path)?;
     writeln!(w, "t,dh,dvh,mode")?;
     for s in samples {
         writeln!(w, "{},{:e},{:e},{}", s.t, s.dh, s.dvh, s.mode.as_str())?;
@@ -643,7 +643,7 @@ fn rms(xs: impl Iterator<Item = f64>) -> f64 {
 }
 
 fn write_kf(path: &Path, kf: &KalmanRun) -> Result<()> {
-    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(path)?;
     writeln!(w, "t,dh,dvh,mode,k1,k2,sigma_h")?;
     for s in &kf.samples {
         writeln!(
@@ -667,7 +667,7 @@ fn write_reference(
     reference: &[Option<f64>],
     height: f64,
 ) -> Result<()> {
-    let mut w = crate::line_file::LineWriter::create(path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(path)?;
     writeln!(w, "t,dh_ref")?;
     let mut line = String::new();
     for (k, r) in reference.iter().enumerate() {

@@ -46,7 +46,7 @@ pub(super) fn csv(
     rows: impl IntoIterator<Item = String>,
 ) -> Result<()> {
     let path = dir.join(name);
-    let mut w = crate::line_file::LineWriter::create(&path)?;
+    let mut w = schuler_io::line_file::LineWriter::create(&path)?;
     writeln!(w, "{header}")?;
     for r in rows {
         writeln!(w, "{r}")?;

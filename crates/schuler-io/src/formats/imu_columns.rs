@@ -34,6 +34,7 @@ use std::fmt;
 use serde::Deserialize;
 
 use super::imu_log::{ImuLayout, STANDARD_GRAVITY};
+use crate::named::Named;
 
 /// Slot of the time in a parsed line (then gyro x, y, z in 1–3, accelerometer in 4–6).
 pub(crate) const SLOT_TIME: u8 = 0;
@@ -60,22 +61,18 @@ pub(crate) const RECOGNISED: &str = "time t, time, timestamp (units s, ms, us, n
 
 /// Unit of the gyro columns: `rad/s` and `deg/s` are rates, `rad` and `deg` angle
 /// increments.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub enum GyroUnit {
     /// Radians per second (rates).
-    #[value(name = "rad/s")]
     #[serde(rename = "rad/s")]
     RadPerSecond,
     /// Degrees per second (rates).
-    #[value(name = "deg/s")]
     #[serde(rename = "deg/s")]
     DegPerSecond,
     /// Radians (increments).
-    #[value(name = "rad")]
     #[serde(rename = "rad")]
     Rad,
     /// Degrees (increments).
-    #[value(name = "deg")]
     #[serde(rename = "deg")]
     Deg,
 }
@@ -106,31 +103,32 @@ impl GyroUnit {
     }
 }
 
+impl Named for GyroUnit {
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (Self::RadPerSecond, "rad/s", "Radians per second (rates)"),
+        (Self::DegPerSecond, "deg/s", "Degrees per second (rates)"),
+        (Self::Rad, "rad", "Radians (increments)"),
+        (Self::Deg, "deg", "Degrees (increments)"),
+    ];
+}
+
 impl fmt::Display for GyroUnit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::RadPerSecond => "rad/s",
-            Self::DegPerSecond => "deg/s",
-            Self::Rad => "rad",
-            Self::Deg => "deg",
-        })
+        f.write_str(self.name())
     }
 }
 
 /// Unit of the accelerometer columns: `m/s^2` and `g` are rates (specific force),
 /// `m/s` velocity increments.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub enum AccelUnit {
     /// Metres per second squared (rates).
-    #[value(name = "m/s^2")]
     #[serde(rename = "m/s^2")]
     MetrePerSecond2,
     /// Standard gravity g₀ = 9.80665 m/s² (rates).
-    #[value(name = "g")]
     #[serde(rename = "g")]
     G,
     /// Metres per second (increments).
-    #[value(name = "m/s")]
     #[serde(rename = "m/s")]
     MetrePerSecond,
 }
@@ -161,18 +159,30 @@ impl AccelUnit {
     }
 }
 
+impl Named for AccelUnit {
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            Self::MetrePerSecond2,
+            "m/s^2",
+            "Metres per second squared (rates)",
+        ),
+        (Self::G, "g", "Standard gravity g₀ = 9.80665 m/s² (rates)"),
+        (
+            Self::MetrePerSecond,
+            "m/s",
+            "Metres per second (increments)",
+        ),
+    ];
+}
+
 impl fmt::Display for AccelUnit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::MetrePerSecond2 => "m/s^2",
-            Self::G => "g",
-            Self::MetrePerSecond => "m/s",
-        })
+        f.write_str(self.name())
     }
 }
 
 /// Unit of the time column: seconds, or integer ticks of ms, µs or ns.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TimeUnit {
     /// Seconds.
@@ -184,6 +194,15 @@ pub enum TimeUnit {
     Us,
     /// Nanoseconds.
     Ns,
+}
+
+impl Named for TimeUnit {
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (Self::S, "s", "Seconds"),
+        (Self::Ms, "ms", "Milliseconds"),
+        (Self::Us, "us", "Microseconds"),
+        (Self::Ns, "ns", "Nanoseconds"),
+    ];
 }
 
 impl TimeUnit {
@@ -858,6 +877,23 @@ mod tests {
         recognise(name)
             .expect("no contradiction")
             .map(|c| (c.slot, c.layout, c.unit))
+    }
+
+    #[test]
+    fn unit_names_are_listed_as_serde_reads_them() {
+        use crate::named::check_listing;
+        check_listing(&[
+            GyroUnit::RadPerSecond,
+            GyroUnit::DegPerSecond,
+            GyroUnit::Rad,
+            GyroUnit::Deg,
+        ]);
+        check_listing(&[
+            AccelUnit::MetrePerSecond2,
+            AccelUnit::G,
+            AccelUnit::MetrePerSecond,
+        ]);
+        check_listing(&[TimeUnit::S, TimeUnit::Ms, TimeUnit::Us, TimeUnit::Ns]);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Output text files that only ever hold whole lines. A run that fails to write (a
 //! full disk, a quota, a pipe gone) cuts the file back to the end of its last whole
 //! line and names the file in its error, so a reader of what is left never meets half
-//! a number; an interrupted run ([`crate::interrupt`]) closes its files between lines
+//! a number; an interrupted run (a signal, see the pipeline) closes its files between lines
 //! the same way.
 //!
 //! - [`LineFile`] appends blocks that end on a line (the fast row writers' blocks).

@@ -72,6 +72,7 @@
 
 use super::error::{InputError, InputErrorKind, in_domain};
 use super::lines::{Delimiter, data_lines, fields, read_lines_whole};
+use crate::named::Named;
 use nalgebra::Vector3;
 use schuler::domain;
 use schuler::earth::Geodetic;
@@ -105,7 +106,7 @@ const SAME_HEIGHT_M: f64 = 100.0;
 type Rows = Vec<(u64, Vec<f64>)>;
 
 /// The position log formats [`read_gnss_log`] reads (`--gnss-format`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum GnssFormat {
     /// Told by the content: NMEA sentences, an RTKLIB `%` column header, else text.
@@ -119,23 +120,34 @@ pub enum GnssFormat {
     Rtklib,
 }
 
-impl GnssFormat {
-    /// The name used in messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            GnssFormat::Auto => "auto",
-            GnssFormat::Text => "text",
-            GnssFormat::Nmea => "nmea",
-            GnssFormat::Rtklib => "rtklib",
-        }
-    }
+impl Named for GnssFormat {
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            Self::Auto,
+            "auto",
+            "Told by the content: NMEA sentences, an RTKLIB `%` column header, else text",
+        ),
+        (
+            Self::Text,
+            "text",
+            "KF-GINS text (4, 7 or 13 columns) or CSV with a header",
+        ),
+        (
+            Self::Nmea,
+            "nmea",
+            "NMEA 0183 sentences: GGA, RMC, VTG, GST",
+        ),
+        (
+            Self::Rtklib,
+            "rtklib",
+            "An RTKLIB solution file (`.pos`, rnx2rtkp or RTKPOST output)",
+        ),
+    ];
 }
 
 /// Solution quality levels, worst first (`--gnss-min-quality`): RTKLIB's `Q` and
 /// NMEA GGA's fix quality mapped onto one scale.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, clap::ValueEnum, serde::Deserialize,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum GnssQuality {
     /// Single point positioning (RTKLIB Q 5; GGA 1, 7 manual, 8 simulator).
@@ -149,16 +161,29 @@ pub enum GnssQuality {
     Fix,
 }
 
-impl GnssQuality {
-    /// The name used in messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            GnssQuality::Single => "single",
-            GnssQuality::Dgps => "dgps",
-            GnssQuality::Float => "float",
-            GnssQuality::Fix => "fix",
-        }
-    }
+impl Named for GnssQuality {
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            Self::Single,
+            "single",
+            "Single point positioning (RTKLIB Q 5; GGA 1, 7 manual, 8 simulator)",
+        ),
+        (
+            Self::Dgps,
+            "dgps",
+            "Differential code positioning (RTKLIB Q 3 SBAS, 4 DGPS; GGA 2 DGPS, 3 PPS)",
+        ),
+        (
+            Self::Float,
+            "float",
+            "Carrier phase with float ambiguities, or PPP (RTKLIB Q 2, 6; GGA 5)",
+        ),
+        (
+            Self::Fix,
+            "fix",
+            "Carrier phase with fixed ambiguities (RTKLIB Q 1; GGA 4)",
+        ),
+    ];
 }
 
 /// How [`read_gnss_log`] reads a position log.
@@ -636,7 +661,7 @@ fn csv_position_cols(h: &CsvHeader) -> Result<PositionCols, InputError> {
 /// The position of latitude, longitude [deg] and height [m] after the checks of
 /// [`schuler::domain`] (a longitude of 0-360 wrapped); else which of the three (0, 1,
 /// 2) is out of its domain, and why.
-pub(crate) fn position_in_domain(
+pub fn position_in_domain(
     lat_deg: f64,
     lon_deg: f64,
     h: f64,
@@ -1052,6 +1077,15 @@ mod tests {
     use super::*;
 
     use crate::formats::temp_file as file;
+
+    #[test]
+    fn format_and_quality_names_are_listed_as_serde_reads_them() {
+        use crate::named::check_listing;
+        use GnssFormat::{Auto, Nmea, Rtklib, Text};
+        check_listing(&[Auto, Text, Nmea, Rtklib]);
+        use GnssQuality::{Dgps, Fix, Float, Single};
+        check_listing(&[Single, Dgps, Float, Fix]);
+    }
 
     #[test]
     fn reads_both_layouts_and_merges_velocity() {
