@@ -11,10 +11,10 @@ use schuler::filter::{Gate, GnssFix, ImuNoise, IntegrationConfig};
 use schuler::session::FilterConfig;
 use schuler::sim::analytic;
 use schuler::sim::sensor_spec::{ImuSpec, Preset};
-use schuler_cli::aided::{Aiding, OutputNames};
-use schuler_cli::navigate::{NavSettings, navigate};
 use schuler_io::formats::ImuReader;
 use schuler_io::output::write_imu_text;
+use schuler_run::aided::{Aiding, OutputNames};
+use schuler_run::navigate::{NavSettings, navigate};
 use std::path::PathBuf;
 
 mod common;
@@ -74,7 +74,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
         outage_test: None,
         baro: Vec::new(),
         // The navigation alone (the HTML report's cost is stated in the README).
-        report: schuler_cli::aided::report::ReportSettings {
+        report: schuler_run::aided::report::ReportSettings {
             html: false,
             ..Default::default()
         },

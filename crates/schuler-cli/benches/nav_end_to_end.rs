@@ -9,10 +9,10 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::sim::analytic::{self, Maneuvering};
-use schuler_cli::navigate::{NavSettings, navigate};
-use schuler_cli::options::EarthChoice;
 use schuler_io::formats::{ImuReadOptions, ImuReader};
 use schuler_io::output::write_imu_text;
+use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::options::EarthChoice;
 use std::path::PathBuf;
 
 const RATE_HZ: f64 = 200.0;

@@ -17,7 +17,7 @@ struct Cli {
 enum Command {
     /// Navigation of an IMU log (KF-GINS text or CSV): free-inertial or aided (GNSS,
     /// barometer, vehicle aids), from a given start, an alignment or in motion.
-    Nav(schuler_cli::commands::nav::NavArgs),
+    Nav(schuler_run::nav::NavArgs),
     /// Initial alignment at rest: gyrocompassing, then the Kalman filter on invariants.
     Align(schuler_cli::commands::align::Args),
     /// A first end-to-end run on built-in simulated data.
@@ -59,7 +59,7 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => match schuler_cli::interrupt::find(&e) {
+        Err(e) => match schuler_run::interrupt::find(&e) {
             // Not a failure of the program: what it says is how far the files got.
             Some(i) => {
                 eprintln!("{}", chain_message(&e));

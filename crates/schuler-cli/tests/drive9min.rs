@@ -7,9 +7,9 @@ use schuler::analysis::errors::{EpochErrors, NavRecord, errors_at};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::rotation::Euler;
 use schuler::session::{MechanizationChoice, MechanizationConfig};
-use schuler_cli::navigate::{NavSettings, navigate};
-use schuler_cli::options::EarthChoice;
 use schuler_io::formats::{ImuReadOptions, ImuReader};
+use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::options::EarthChoice;
 mod common;
 
 use std::collections::HashMap;

@@ -407,7 +407,7 @@ fn sensor_errors_log(path: &Path, _: &[u8]) -> Result<bool, String> {
 }
 
 fn scenario(path: &Path, _: &[u8]) -> Result<bool, String> {
-    let spec = schuler_cli::commands::simulate::load_scenario(path);
+    let spec = schuler_run::scenario::load_scenario(path);
     judged(path, spec, |spec| {
         // The models and the motion must build or be refused, never panic; a
         // refusal here comes from the library and names the key.
@@ -423,16 +423,12 @@ fn scenario(path: &Path, _: &[u8]) -> Result<bool, String> {
 }
 
 fn nav_config(path: &Path, _: &[u8]) -> Result<bool, String> {
-    let args = schuler_cli::commands::nav::NavArgs {
+    let args = schuler_run::nav::NavArgs {
         config: Some(path.to_path_buf()),
         ..Default::default()
     };
     // An accepted configuration is checked again by the session when it opens.
-    judged(
-        path,
-        schuler_cli::commands::nav::parse_nav_args(args),
-        |_| Ok(()),
-    )
+    judged(path, schuler_run::nav::parse_nav_args(args), |_| Ok(()))
 }
 
 /// The KF-GINS configuration, its `@DIR@` made the input's folder, where the GNSS seed

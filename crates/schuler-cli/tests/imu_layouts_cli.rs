@@ -12,8 +12,8 @@ use std::ffi::OsStr;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use schuler_cli::imu_input::ImuInputOptions;
 use schuler_io::formats::ImuReader;
+use schuler_run::imu_input::ImuInputOptions;
 
 /// The runs stop here [s]: the rest, the turn, the climb and the GNSS outage.
 const END: f64 = 600.0;

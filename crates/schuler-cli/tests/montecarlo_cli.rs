@@ -1,10 +1,10 @@
-//! Monte-Carlo campaigns (`schuler montecarlo`, `schuler_cli::campaign`) on
+//! Monte-Carlo campaigns (`schuler montecarlo`, `schuler_run::campaign`) on
 //! `examples/montecarlo.toml`: a 5-minute drive at 100 Hz with a tactical IMU, GNSS
 //! at 1 Hz and a 30-s outage, navigated with the matching noise model.
 
 use assert_cmd::Command;
 use schuler::analysis::consistency::mean_bounds;
-use schuler_cli::campaign::{self, CampaignConfig, aggregate::Aggregate, csv};
+use schuler_run::campaign::{self, CampaignConfig, aggregate::Aggregate, csv};
 use std::path::{Path, PathBuf};
 
 fn example() -> PathBuf {

@@ -10,10 +10,10 @@ use schuler::nav::NavState;
 use schuler::session::{MechanizationChoice, MechanizationConfig, MechanizationKind, Summary};
 use schuler::sim::analytic::{self, Trajectory};
 use schuler::sim::jet::{Jet, JetMat3, JetVec3};
-use schuler_cli::navigate::{NavSettings, navigate};
-use schuler_cli::options::EarthChoice;
 use schuler_io::formats::{ImuReadOptions, ImuReader};
 use schuler_io::output::{CSV_HEADER_EXTENDED, write_imu_text};
+use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::options::EarthChoice;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 

@@ -1,21 +1,21 @@
 //! `align(imu, pos=...)`: `schuler align` (coarse gyrocompassing, then the Kalman
 //! filter on the invariants) on a log at rest, from a file or arrays, with the CLI's
 //! own options and code ([`schuler_cli::commands::align`],
-//! [`schuler_cli::alignment`]); what it gives is `align.json`'s content, the
+//! [`schuler_run::alignment`]); what it gives is `align.json`'s content, the
 //! `align_convergence.csv` table and the printed report. The same tables describe the
 //! alignment of `navigate(..., align=True)`.
 
 use crate::columns::{CONVERGENCE, Columns};
 use crate::errors::IntoPy;
-use crate::run::Began;
 use clap::Parser;
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use schuler::align::Alignment;
-use schuler_cli::alignment::{align_on, convergence_row, read_stage, summary_text, to_json};
 use schuler_cli::commands::align::{Args, setup};
 use schuler_io::formats::ImuReader;
+use schuler_run::alignment::{align_on, convergence_row, read_stage, summary_text, to_json};
+use schuler_run::nav::Began;
 
 /// `schuler align`'s arguments.
 #[derive(Parser, Debug)]

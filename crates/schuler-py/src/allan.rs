@@ -99,7 +99,7 @@ pub fn allan_fit<'py>(
     };
     let (allan, fits, warnings) = py
         .detach(|| -> anyhow::Result<_> {
-            let max_tau = schuler_cli::options::quantity(
+            let max_tau = schuler_run::options::quantity(
                 "max-tau",
                 &args.max_tau,
                 schuler::units::Dimension::Time,

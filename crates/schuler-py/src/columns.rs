@@ -69,7 +69,7 @@ pub const NAV: &[&str] = &[
     "yaw_deg",
 ];
 
-/// Columns of the standard deviations, as `std.txt` ([`schuler_cli::drive::std_row`]).
+/// Columns of the standard deviations, as `std.txt` ([`schuler_run::drive::std_row`]).
 pub const STD: &[&str] = &[
     "t_s",
     "std_n_m",
@@ -96,7 +96,7 @@ pub const STD: &[&str] = &[
 ];
 
 /// Columns of the sensor-error estimates, as `imu_err.txt`
-/// ([`schuler_cli::drive::imu_err_row`]).
+/// ([`schuler_run::drive::imu_err_row`]).
 pub const SENSOR: &[&str] = &[
     "t_s",
     "gyro_bias_x_degph",
@@ -149,7 +149,7 @@ pub const GNSS: &[&str] = &[
 ];
 
 /// Columns of an alignment's convergence, as `align_convergence.csv`
-/// ([`schuler_cli::alignment::convergence_row`]).
+/// ([`schuler_run::alignment::convergence_row`]).
 pub const CONVERGENCE: &[&str] = &[
     "t_s",
     "roll_std_deg",

@@ -24,7 +24,7 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use run::{Plan, Tables};
-use schuler_cli::aided::GivenReadings;
+use schuler_run::aided::GivenReadings;
 
 /// Views of IMU columns `t, dtheta_x..z, dvel_x..z` and an optional `dt`.
 pub(crate) fn imu_views<'a>(
@@ -146,7 +146,7 @@ fn _schuler(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<session::PySession>()?;
     m.add("SchulerError", m.py().get_type::<errors::SchulerError>())?;
     m.add("InputError", m.py().get_type::<errors::InputError>())?;
-    m.add("CAMPAIGN_COLUMNS", schuler_cli::campaign::COLUMNS.to_vec())?;
+    m.add("CAMPAIGN_COLUMNS", schuler_run::campaign::COLUMNS.to_vec())?;
     m.add("NAV_COLUMNS", columns::NAV.to_vec())?;
     Ok(())
 }

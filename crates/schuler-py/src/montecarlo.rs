@@ -1,4 +1,4 @@
-//! `montecarlo(...)`: the CLI's Monte-Carlo campaign ([`schuler_cli::campaign`]) on a
+//! `montecarlo(...)`: the CLI's Monte-Carlo campaign ([`schuler_run::campaign`]) on a
 //! campaign file or text, its table (one row per run, `runs.csv`'s columns) as a dict
 //! of numpy arrays. The same function on a list of seeds serves `schuler.dask`, which
 //! sends each seed to a worker of a cluster.
@@ -7,7 +7,7 @@ use crate::errors::IntoPy;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use schuler_cli::campaign::{self, COLUMNS, CampaignConfig};
+use schuler_run::campaign::{self, COLUMNS, CampaignConfig};
 use std::path::{Path, PathBuf};
 
 /// Where a campaign comes from: a file, or TOML or JSON text (relative paths from

@@ -4,9 +4,9 @@
 
 use anyhow::Result;
 use clap::Parser;
-use schuler_cli::aided::AidingOptions;
-use schuler_cli::commands::nav::NavArgs;
-use schuler_cli::imu_input::ImuInputOptions;
+use schuler_run::aided::AidingOptions;
+use schuler_run::imu_input::ImuInputOptions;
+use schuler_run::nav::NavArgs;
 
 /// The IMU reader's options with the time window.
 #[derive(Parser, Debug)]
@@ -32,7 +32,7 @@ struct GnssFlags {
 
 /// `schuler nav`'s arguments from `flags`.
 pub fn nav_args(flags: &[String]) -> Result<NavArgs> {
-    schuler_cli::campaign::navigate::nav_args(flags)
+    schuler_run::campaign::navigate::nav_args(flags)
 }
 
 /// The IMU reader's options and time window from `flags`.

@@ -1,4 +1,4 @@
-//! A navigation run as the CLI's `nav` sets it up ([`schuler_cli::commands::nav`]):
+//! A navigation run as `schuler nav` sets it up ([`schuler_run::nav`]):
 //! the options parsed and checked, the aiding resolved, the library's
 //! [`schuler::session::Session`] opened on the chosen Earth model; what comes out is
 //! collected into tables instead of files, with the CLI's conversions, so the numbers
@@ -9,26 +9,23 @@ use crate::columns::{Columns, INNOVATIONS, NAV, SENSOR, STD};
 use anyhow::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use schuler::align::Alignment;
-use schuler::align::in_motion::InMotionStart;
 use schuler::earth::EarthModel;
 use schuler::earth::{Sphere, Wgs84, Wgs84Series};
 use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::Start;
 use schuler::session::{Epoch, Event, Finished, Session};
-use schuler_cli::aided::record::InnovationRow;
-use schuler_cli::aided::{Aiding, GivenReadings};
-use schuler_cli::alignment::AlignOptions;
-use schuler_cli::commands::nav::{
-    BANK_MEMBERS, BANK_SECONDS, InitChoice, align_start, motion_start, parse_nav_args,
-    resolve_aiding,
-};
-use schuler_cli::drive::{Refusal, imu_err_row, std_row};
-use schuler_cli::navigate::{NavSettings, decide_heading, open_session};
-use schuler_cli::options::EarthChoice;
 use schuler_io::formats::InputError;
 use schuler_io::output::nav_fields;
+use schuler_run::aided::record::InnovationRow;
+use schuler_run::aided::{Aiding, GivenReadings};
+use schuler_run::alignment::AlignOptions;
+use schuler_run::drive::{Refusal, imu_err_row, std_row};
+use schuler_run::nav::{
+    BANK_MEMBERS, BANK_SECONDS, Began, InitChoice, begin, parse_nav_args, resolve_aiding,
+};
+use schuler_run::navigate::{NavSettings, decide_heading, open_session};
+use schuler_run::options::EarthChoice;
 
 /// The settings and aiding of a run, from the CLI's flags.
 pub struct Plan {
@@ -40,17 +37,6 @@ pub struct Plan {
     pub align: Option<AlignOptions>,
     /// How the run starts (`--init`).
     pub init: InitChoice,
-}
-
-/// How a run began: from the given state, after an alignment at rest, or in motion
-/// from the GNSS fixes.
-pub enum Began {
-    /// From `--init-pos`, `--init-vel`, `--init-att`.
-    Given,
-    /// After `--align`.
-    Aligned(Box<Alignment>),
-    /// With `--init gnss` or `gnss-any-heading`.
-    InMotion(InMotionStart),
 }
 
 impl Plan {
@@ -74,17 +60,7 @@ impl Plan {
         I: Iterator<Item = Result<ImuSample, InputError>>,
     {
         let (s, aiding) = (&self.settings, self.aiding.as_mut());
-        Ok(match (&self.align, self.init) {
-            (Some(opts), _) => {
-                let (start, head, a) = align_start(s, opts, samples, aiding)?;
-                (start, head, Began::Aligned(Box::new(a)))
-            }
-            (None, InitChoice::Given) => (s.start(), Vec::new(), Began::Given),
-            (None, init) => {
-                let (start, head, m) = motion_start(s, samples, aiding, init)?;
-                (start, head, Began::InMotion(m))
-            }
-        })
+        begin(s, self.align.as_ref(), self.init, samples, aiding)
     }
 }
 

@@ -14,9 +14,9 @@ use schuler::filter::GnssFix;
 use schuler::filter::smoother::Smoothed;
 use schuler::imu::ImuSample;
 use schuler::session::{Aid, Finished};
-use schuler_cli::aided::GivenReadings;
-use schuler_cli::aided::vehicle::GivenVehicle;
-use schuler_cli::commands::nav::InitChoice;
+use schuler_run::aided::GivenReadings;
+use schuler_run::aided::vehicle::GivenVehicle;
+use schuler_run::nav::InitChoice;
 
 /// A navigation session fed by pushes; its tables are taken as they grow.
 #[pyclass(name = "Session", module = "schuler._schuler")]

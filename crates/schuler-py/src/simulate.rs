@@ -14,8 +14,8 @@ use schuler::nav::NavState;
 use schuler::sim::analytic::Kinematics;
 use schuler::sim::receivers::{BaroReading, GnssFix};
 use schuler::sim::run::{ImuErrorTruth, ScenarioSpec, SimSink, simulate};
-use schuler_cli::drive::imu_err_row;
 use schuler_io::output::nav_fields;
+use schuler_run::drive::imu_err_row;
 use std::path::Path;
 
 /// Columns of the truth after [`NAV`]'s: angular rate [rad/s] and specific force
@@ -99,7 +99,7 @@ impl SimSink for Collected {
 /// The scenario of `text` (`"toml"` or `"json"`), or of the file `path`.
 fn scenario(text: Option<&str>, format: &str, path: Option<&Path>) -> anyhow::Result<ScenarioSpec> {
     match (text, path) {
-        (_, Some(p)) => schuler_cli::commands::simulate::load_scenario(p),
+        (_, Some(p)) => schuler_run::scenario::load_scenario(p),
         (Some(t), None) if format == "json" => {
             serde_json::from_str(t).context("in the scenario (dict)")
         }
@@ -127,7 +127,7 @@ pub fn simulate_scenario<'py>(
         gnss: Columns::joined(&[GNSS, &["outlier"]]),
         baro: Columns::new(&["t_s", "h_m", "outlier"]),
         sensor_errors: Columns::new(crate::columns::SENSOR),
-        gnss_velocity: schuler_cli::commands::simulate::simulates_gnss_velocity(&spec),
+        gnss_velocity: schuler_run::scenario::simulates_gnss_velocity(&spec),
     };
     py.detach(|| simulate(&spec, &mut c)).py_err(py)?;
     let d = PyDict::new(py);

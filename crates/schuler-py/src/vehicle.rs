@@ -7,9 +7,9 @@
 use crate::arrays::rows;
 use numpy::ndarray::ArrayView1;
 use schuler::filter::HeadingReading;
-use schuler_cli::aided::vehicle::GivenVehicle;
 use schuler_io::formats::InputError;
 use schuler_io::formats::vehicle::{heading_readings, odometer_readings, rest_intervals};
+use schuler_run::aided::vehicle::GivenVehicle;
 use std::path::Path;
 
 /// Columns of rest intervals: start and end [s].

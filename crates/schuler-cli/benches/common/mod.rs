@@ -3,9 +3,9 @@
 
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::sim::analytic::{self, Maneuvering};
-use schuler_cli::navigate::NavSettings;
-use schuler_cli::options::EarthChoice;
 use schuler_io::formats::ImuReadOptions;
+use schuler_run::navigate::NavSettings;
+use schuler_run::options::EarthChoice;
 use std::path::PathBuf;
 
 /// The flight (Wuhan, 500 m: climbs, turns, accelerations).

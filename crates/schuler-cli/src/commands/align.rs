@@ -1,16 +1,16 @@
 //! `schuler align`: initial alignment of an IMU log recorded at rest (coarse
 //! gyrocompassing, then the Kalman filter on invariants), with a report, `align.json`,
 //! the convergence history as CSV and an SVG plot. The same settings serve
-//! `schuler nav --align` ([`crate::alignment`]).
+//! `schuler nav --align` ([`schuler_run::alignment`]).
 
-use crate::alignment::{AlignOptions, align_on, read_stage, summary_text, write_outputs};
-use crate::imu_input::ImuInputOptions;
-use crate::options::{EarthChoice, Triple};
 use anyhow::{Context, Result, bail};
 use schuler::align::AlignConfig;
 use schuler::earth::Geodetic;
 use schuler::filter::ImuNoise;
 use schuler_io::formats::ImuReader;
+use schuler_run::alignment::{AlignOptions, align_on, read_stage, summary_text, write_outputs};
+use schuler_run::imu_input::ImuInputOptions;
+use schuler_run::options::{EarthChoice, Triple};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -20,9 +20,6 @@
 //! their median; otherwise the curve measures the motion and a warning names the
 //! file.
 
-use crate::imu_input::ImuInputOptions;
-use crate::options::quantity;
-use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use schuler::align::prefilter::BlockSums;
@@ -35,6 +32,9 @@ use schuler::earth::Wgs84;
 use schuler::imu::ImuSample;
 use schuler::units::{DEG, Dimension, G0, Unit};
 use schuler_io::formats::ImuReader;
+use schuler_report::plot::{LineStyle, Plot};
+use schuler_run::imu_input::ImuInputOptions;
+use schuler_run::options::quantity;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -727,11 +727,11 @@ pub fn run(args: Args) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::aided::AidingOptions;
-    use crate::options::GradeChoice;
     use schuler::imu::model::ImuModel;
     use schuler::sim::imu_model::ImuSimulator;
     use schuler::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, UG};
+    use schuler_run::aided::AidingOptions;
+    use schuler_run::options::GradeChoice;
 
     /// A static log of `len` samples at 100 Hz from `model` (zero rate, gravity on z).
     fn log(model: ImuModel, len: usize) -> Vec<ImuSample> {

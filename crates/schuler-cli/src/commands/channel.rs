@@ -8,11 +8,6 @@
 //! and the plots `dr.svg` (km), `dv.svg` (m/s), `alpha.svg` (arcsec), like the text's
 //! figures 4-15. Every value with a unit goes through `schuler::units`.
 
-use crate::options::{
-    SphereArgs, acceleration, angle, angular_rate, in_domain, is_positive, length, opt_in_domain,
-    ratio, time, velocity,
-};
-use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use schuler::channel::ChannelError;
@@ -22,6 +17,11 @@ use schuler::channel::profile::{BodyAngleProfile, SpeedProfile};
 use schuler::channel::run::{ChannelConfig, ChannelRun, simulate};
 use schuler::domain::Domain;
 use schuler::units::{ARCSEC, DEG};
+use schuler_report::plot::{LineStyle, Plot, time_axis};
+use schuler_run::options::{
+    SphereArgs, acceleration, angle, angular_rate, in_domain, is_positive, length, opt_in_domain,
+    ratio, time, velocity,
+};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::io::Write as _;

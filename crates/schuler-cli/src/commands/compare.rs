@@ -6,12 +6,12 @@
 //! statistics are the library's ([`schuler::analysis::errors`],
 //! [`schuler::analysis::statistics`]), shared with the aided run's report.
 
-use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result};
 use schuler::analysis::errors::EpochErrors;
 use schuler::analysis::statistics::{Comparison, OutageMax, QUANTITIES, Quantity, compare};
 use schuler_io::formats::nav::{NavFormat, read_nav};
 use schuler_io::output::write_errors_csv;
+use schuler_report::plot::{LineStyle, Plot};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -14,10 +14,6 @@
 //! later) and only the GNSS fixes after `starttime`. [`KfGinsOptions`] asks for more:
 //! the report and diagnostics, `nav.csv`, a gate, TR8350.2's gravity.
 
-use crate::aided::report::ReportSettings;
-use crate::aided::{Aiding, OutputNames};
-use crate::navigate::{NavSettings, navigate};
-use crate::options::{EarthChoice, GravityChoice};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
@@ -28,6 +24,10 @@ use schuler::rotation::Euler;
 use schuler::session::{FilterConfig, MechanizationChoice, MechanizationConfig, Start};
 use schuler::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MGAL, PPM};
 use schuler_io::formats::{ImuFormat, ImuLayout, ImuReadOptions};
+use schuler_run::aided::report::ReportSettings;
+use schuler_run::aided::{Aiding, OutputNames};
+use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::options::{EarthChoice, GravityChoice};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -305,7 +305,7 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
     // KF-GINS skips the fixes up to and including `starttime` (its start is the
     // configured state, not a fix). The log is streamed into the store (memory
     // bounded whatever its length); it must give standard deviations.
-    let mut fixes = crate::aided::fixes::Fixes::default();
+    let mut fixes = schuler_run::aided::fixes::Fixes::default();
     schuler_io::formats::gnss::for_each_text_record(&y.gnsspath, None, |r| {
         if r.fix.t > y.starttime && (y.endtime < 0.0 || r.fix.t <= y.endtime) {
             fixes.push(&r.fix);

@@ -10,14 +10,15 @@ pub mod demo;
 pub mod kf_gins;
 pub mod montecarlo;
 pub mod nav;
+pub mod nav_bag;
 pub mod platform;
 pub mod simulate;
 pub mod vertical;
 
 /// `schuler nav`: a KF-GINS configuration (`--kf-gins-config`) runs as KF-GINS does
 /// ([`kf_gins::run`]), anything else as [`nav::run`].
-pub fn run_nav(args: nav::NavArgs) -> anyhow::Result<()> {
-    crate::interrupt::watch();
+pub fn run_nav(args: schuler_run::nav::NavArgs) -> anyhow::Result<()> {
+    schuler_run::interrupt::watch();
     match &args.kf_gins_config {
         Some(path) => kf_gins::run(
             path,
@@ -26,7 +27,7 @@ pub fn run_nav(args: nav::NavArgs) -> anyhow::Result<()> {
                 nav_csv: args.nav_csv,
                 gate: args.aiding.gate,
                 gravity: args.gravity,
-                propagation_interval: crate::options::quantity(
+                propagation_interval: schuler_run::options::quantity(
                     "propagation-interval",
                     &args.aiding.propagation_interval,
                     schuler::units::Dimension::Time,

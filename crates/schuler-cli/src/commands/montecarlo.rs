@@ -1,8 +1,8 @@
-//! `schuler montecarlo`: a campaign ([`crate::campaign`]) of `--runs` seeds from
+//! `schuler montecarlo`: a campaign ([`schuler_run::campaign`]) of `--runs` seeds from
 //! `--seed` on every core, its table, summary and report written into `--out`.
 
-use crate::campaign::{self, CampaignConfig, aggregate::Aggregate};
 use anyhow::{Result, bail};
+use schuler_run::campaign::{self, CampaignConfig, aggregate::Aggregate};
 use std::path::PathBuf;
 use std::time::Instant;
 

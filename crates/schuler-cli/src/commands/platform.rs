@@ -14,8 +14,6 @@
 //! `tilt_east.svg`, `heading.svg`), the table of errors at 1 h (or at the end of a
 //! shorter run) as `table.csv` and `table.md`, and `summary.json`.
 
-use crate::options::in_domain;
-use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use nalgebra::{Vector3, Vector6};
 use schuler::earth::{EarthModel, Sphere, Wgs84};
@@ -26,6 +24,8 @@ use schuler::sim::run::EarthSpec;
 use schuler::sim::scenario::{MotionSpec, Quantity, SegmentSpec, StartSpec};
 use schuler::sim::sensor_spec::ImuSpec;
 use schuler::units::{ARCSEC, Dimension};
+use schuler_report::plot::{LineStyle, Plot, time_axis};
+use schuler_run::options::in_domain;
 use serde::Deserialize;
 use serde_json::json;
 use std::fmt::Write as _;

@@ -30,7 +30,9 @@
 //! ([`schuler::sim::run::simulate_with`]). The same scenario and seed give the same
 //! bytes.
 
-use crate::drive::{imu_err_row, push_table_row};
+use schuler_run::drive::{imu_err_row, push_table_row};
+use schuler_run::scenario::{load_scenario, simulates_gnss_velocity};
+
 use anyhow::{Context, Result};
 use schuler::sim::receivers::GnssFix;
 use schuler::sim::run::{ImuEpoch, ScenarioSpec, SimBlock, simulate_with};
@@ -221,13 +223,6 @@ fn push_shortest_line(out: &mut Vec<u8>, xs: &[f64], sep: u8) {
     out.push(b'\n');
 }
 
-/// Whether the scenario's receiver measures velocity (`gnss.velocity_std` given):
-/// without, its fixes' velocity is the truth with a standard deviation of 0, not a
-/// measurement, and `gnss.csv` has no velocity columns.
-pub fn simulates_gnss_velocity(spec: &ScenarioSpec) -> bool {
-    spec.gnss.as_ref().is_some_and(|g| g.velocity_std.is_some())
-}
-
 /// `gnss.csv`'s header (velocity columns with `velocity`).
 fn gnss_csv_header(velocity: bool) -> String {
     let velocity = if velocity {
@@ -395,28 +390,6 @@ impl Files {
     }
 }
 
-/// Read and parse a scenario file, and the gnss-ins-sim motion file it names (a path
-/// relative to the scenario's folder).
-pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
-    let text = schuler_io::formats::read_config_text(path)?;
-    let spec: ScenarioSpec =
-        toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
-    with_motion_csv(spec, path.parent().unwrap_or(Path::new("")))
-}
-
-/// `spec` with its `motion_csv` (a path relative to `dir`), if it names one, read.
-pub fn with_motion_csv(mut spec: ScenarioSpec, dir: &Path) -> Result<ScenarioSpec> {
-    if let Some(csv) = &spec.motion_csv {
-        let csv_path = dir.join(csv);
-        let text = String::from_utf8_lossy(&schuler_io::formats::read_lines_whole(&csv_path)?)
-            .into_owned();
-        let def = schuler::sim::gnss_ins_sim::parse(&text)
-            .with_context(|| format!("in {}", csv_path.display()))?;
-        spec.imported = Some(def);
-    }
-    Ok(spec)
-}
-
 /// Simulate `spec` into `dir`; returns the summary.
 pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::run::SimSummary> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -431,7 +404,7 @@ pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::
             files.write(text)?;
             (samples, written_to) = (samples + text.samples, text.last_t);
             // A signal stops the run after a whole block: every file ends there.
-            match crate::interrupt::requested() {
+            match schuler_run::interrupt::requested() {
                 Some(_) => Err(std::io::Error::from(std::io::ErrorKind::Interrupted)),
                 None => Ok(()),
             }
@@ -440,7 +413,7 @@ pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::
     // Every block written is in the files, whole, even when the simulation stopped
     // early.
     drop(files);
-    if let (Err(_), Some(i)) = (&summary, crate::interrupt::requested()) {
+    if let (Err(_), Some(i)) = (&summary, schuler_run::interrupt::requested()) {
         return Err(anyhow::Error::new(i).context(format!(
             "stopped at t = {written_to} s: the files in {} hold the {samples} IMU samples up to \
              there, with the GNSS, barometer and sensor-error lines up to the same time",
@@ -457,7 +430,7 @@ pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::
 
 /// `schuler simulate`.
 pub fn run(args: Args) -> Result<()> {
-    crate::interrupt::watch();
+    schuler_run::interrupt::watch();
     let started = Instant::now();
     let mut spec = load_scenario(&args.config)?;
     if let Some(seed) = args.seed {

@@ -11,8 +11,6 @@
 //! (eigenvalues, e-fold time, settling and reconvergence times, detector counts) and the
 //! plots `dh.svg`, `dvh.svg`.
 
-use crate::options::{SphereArgs, acceleration, is_positive, length, time, velocity};
-use crate::plot::{LineStyle, Plot, time_axis};
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use schuler::channel::ChannelError;
@@ -26,6 +24,8 @@ use schuler::channel::vertical::{
     simulate_aided, simulate_free,
 };
 use schuler::units::{self, Dimension};
+use schuler_report::plot::{LineStyle, Plot, time_axis};
+use schuler_run::options::{SphereArgs, acceleration, is_positive, length, time, velocity};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::io::Write as _;

@@ -5,11 +5,11 @@
 use super::ModeRun;
 use super::figure3::{self, Figure3, LegBudget};
 use super::page::{m, svg, table_with_csv};
-use crate::plot::{LineStyle, Plot};
-use crate::report::Report;
 use anyhow::Result;
 use schuler::analysis::errors::EpochErrors;
 use schuler::units::{DEG_PER_H, UG};
+use schuler_report::html::Report;
+use schuler_report::plot::{LineStyle, Plot};
 use std::path::Path;
 
 const HEADER: [&str; 15] = [

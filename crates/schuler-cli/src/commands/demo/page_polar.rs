@@ -8,12 +8,12 @@ use super::modes::Track;
 use super::page::{csv, find, m, plot_circular, svg, table_with_csv, write_mode};
 use super::polar::Polar;
 use super::{ModeRun, crossing::Crossing};
-use crate::plot::{LineStyle, Plot};
-use crate::report::Report;
 use anyhow::Result;
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::nav::NavState;
+use schuler_report::html::Report;
+use schuler_report::plot::{LineStyle, Plot};
 use std::path::Path;
 
 /// Columns of `polar_summary.csv` and the section's table.

@@ -72,7 +72,7 @@ impl CampaignConfig {
         let scenario: ScenarioSpec = toml::Value::Table(table)
             .try_into()
             .with_context(|| format!("in {origin}: the scenario"))?;
-        let scenario = crate::commands::simulate::with_motion_csv(scenario, dir)?;
+        let scenario = crate::scenario::with_motion_csv(scenario, dir)?;
         let mut nav_flags = Vec::new();
         if let Some(nav) = nav {
             let toml::Value::Table(t) = nav else {

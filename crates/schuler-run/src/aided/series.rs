@@ -1,7 +1,7 @@
 //! The series a report plot draws, built from a stored record in bounded memory: at
 //! most [`CAP`] points are kept as they are; a longer series is thinned to the
 //! lowest and highest value of each run of consecutive points (as the SVG writer
-//! thins each pixel column, [`crate::plot`]), so a 10-hour run's plot costs the
+//! thins each pixel column, [`schuler_report::plot`]), so a 10-hour run's plot costs the
 //! memory of a 1-hour one's and keeps its extremes (outliers, spikes) visible.
 //!
 //! Lines break across data gaps: a NaN point goes before each step longer than twice

@@ -1,12 +1,12 @@
 //! One run's navigation: `schuler nav`'s own option parsing, aiding resolution and
-//! session set-up ([`crate::commands::nav`], [`crate::navigate::open_session`]) on the
+//! session set-up ([`crate::nav`], [`crate::navigate::open_session`]) on the
 //! simulated streams in memory, with the simulated truth as the report's truth so that
 //! the filter's snapshots carry NEES.
 
 use super::config::{CampaignConfig, Streams};
 use super::record::Recorded;
 use crate::aided::GivenReadings;
-use crate::commands::nav::{InitChoice, NavArgs, parse_nav_args, resolve_aiding};
+use crate::nav::{InitChoice, NavArgs, parse_nav_args, resolve_aiding};
 use crate::navigate::{NavSettings, open_session};
 use crate::options::EarthChoice;
 use anyhow::{Context, Result, bail};

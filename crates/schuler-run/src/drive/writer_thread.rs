@@ -10,7 +10,7 @@
 //! writer hands each emptied batch back, so that after the first few the batches are
 //! reused: no allocation per epoch or per batch, none freed on the other thread.
 
-use crate::drive::Outputs;
+use super::Outputs;
 use anyhow::{Result, anyhow};
 use schuler::earth::EarthModel;
 use schuler::session::{Epoch, Event, Session};

@@ -7,7 +7,7 @@
 //! values break a line instead of corrupting it.
 //!
 //! ```
-//! use schuler_cli::plot::{LineStyle, Plot};
+//! use schuler_report::plot::{LineStyle, Plot};
 //! let t = [0.0, 1.0, 2.0];
 //! let svg = Plot::new("Velocity error", "t [h]", "dV [m/s]")
 //!     .line("nonlinear", &t, &[0.0, 0.5, 0.2], LineStyle::Solid)
@@ -16,13 +16,13 @@
 //! assert!(svg.starts_with("<svg") && svg.contains("dV [m/s]"));
 //! ```
 
-use crate::report::escape as esc;
+use crate::html::escape as esc;
 use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Time axis: hours for runs of 2 h or more, minutes from 10 min, else seconds.
-pub(crate) fn time_axis(duration: f64) -> (f64, &'static str) {
+pub fn time_axis(duration: f64) -> (f64, &'static str) {
     if duration >= 7200.0 {
         (3600.0, "t [h]")
     } else if duration >= 600.0 {

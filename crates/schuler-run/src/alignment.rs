@@ -3,7 +3,6 @@
 //! chosen Earth model, and its report, `align.json` and convergence files.
 
 use crate::options::{EarthChoice, GradeChoice};
-use crate::plot::{LineStyle, Plot};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, AlignError, Alignment, HeadingSource, MotionReport, align};
@@ -12,6 +11,7 @@ use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
 use schuler::units::{DEG_PER_H, Dimension, MGAL, parse_as_or_si};
+use schuler_report::plot::{LineStyle, Plot};
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::Path;

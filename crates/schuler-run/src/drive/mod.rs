@@ -6,10 +6,11 @@
 //! reason). On a read error everything computed so far is written before the error is
 //! returned.
 
+pub mod writer_thread;
+
 use crate::aided::feed::AidFeed;
 use crate::aided::record::InnovationLog;
 use crate::aided::spilled::Spilled;
-use crate::writer_thread::WriterThread;
 use anyhow::Result;
 use nalgebra::Vector3;
 use schuler::earth::EarthModel;
@@ -25,6 +26,7 @@ use schuler_io::line_file::{LineFile, write_whole};
 use schuler_io::output::{NavEpoch, NavWriter, push_fixed};
 use schuler_io::text_block::{TextBlock, put_first_field};
 use std::path::Path;
+use writer_thread::WriterThread;
 
 /// Text writer for `std.txt` and `imu_err.txt`, through the fast row writer
 /// ([`TextBlock`]).

@@ -1,4 +1,4 @@
-//! `schuler nav --bag`: a ROS 2 bag as the run's input (its IMU, GNSS, velocity,
+//! A ROS 2 bag as a navigation run's input (`schuler nav --bag`) (its IMU, GNSS, velocity,
 //! barometer and odometry topics, [`schuler_io::bag::input`]) and `--out-bag`, the result as
 //! a bag ([`schuler_io::bag::output`]). The IMU's axes are FLU (REP 103) unless
 //! `--imu-axes`/`--imu-rotation` say otherwise; `--imu-time-offset` shifts every
@@ -6,15 +6,13 @@
 //! for missing covariances; the IMU's covariances give the noise model where
 //! `--arw`/`--vrw` are not given.
 
-use crate::commands::nav::{NavPlan, filter_grade, navigate_samples, print_summary};
+use crate::nav::NavPlan;
 use crate::options::Triple;
 use anyhow::{Result, bail};
-use indicatif::ProgressBar;
 use nalgebra::Vector3;
 use schuler::units::{Dimension, parse_as_or_si};
-use schuler_io::bag::input::{BagPlan, BagReadOptions, Kind, flu_to_frd, plan};
+use schuler_io::bag::input::{BagPlan, BagReadOptions, flu_to_frd, plan};
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// The bag flags of `schuler nav`, also the keys of `--config` with underscores
 /// (`bag = "run.mcap"`, `imu_topic = "/imu/data"`, `out_bag = "nav.mcap"`; flags win).
@@ -77,7 +75,7 @@ impl BagArgs {
 }
 
 /// The reading options of the run's flags.
-fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<BagReadOptions> {
+pub fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<BagReadOptions> {
     let read = &plan.settings.read;
     let a = &plan.aiding;
     let default_gnss_std = match a.gnss_std {
@@ -111,114 +109,7 @@ fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<BagR
     })
 }
 
-/// The chosen topics, the clock and what was found, on stderr.
-fn describe(p: &BagPlan) {
-    eprintln!(
-        "{}: {}",
-        p.path.display(),
-        schuler_io::bag::clock::describe(&p.clock)
-    );
-    for kind in Kind::ALL {
-        if let Some(t) = p.topic(kind) {
-            eprintln!("{}: {} from {t}", p.path.display(), kind.type_name());
-        }
-    }
-    eprintln!(
-        "{}: nominal IMU rate {:.6} Hz; {} GNSS fixes ({} NO_FIX skipped, {} with velocity), {} barometer, {} odometer readings",
-        p.path.display(),
-        1.0 / p.nominal_dt,
-        p.aids.fixes.len(),
-        p.aids.no_fix,
-        p.aids.fixes.iter().filter(|f| f.vel.is_some()).count(),
-        p.aids.baro.len(),
-        p.aids.odometer.len()
-    );
-    if p.aids.unmatched_velocities > 0 {
-        eprintln!(
-            "warning: {}: {} velocity messages have no fix at the same stamp and are not used",
-            p.path.display(),
-            p.aids.unmatched_velocities
-        );
-    }
-}
-
-/// The barometer's and the odometer's noise from the messages' variances, where they
-/// give them and neither a flag nor a file of the same kind does (as the IMU's
-/// covariances give ARW and VRW); printed.
-fn noise_of_variances(plan: &mut NavPlan, bag: &BagPlan) {
-    let a = &mut plan.aiding;
-    let path = bag.path.display();
-    if let Some(std) = bag.aids.baro_std
-        && a.baro.is_none()
-        && a.baro_std.is_none()
-    {
-        a.baro_std = Some(std.to_string());
-        eprintln!(
-            "{path}: barometer noise from its pressure variances: {std} m (--baro-std overrides)"
-        );
-    }
-    if let Some(std) = bag.aids.odometer_std
-        && a.odometer.is_none()
-        && a.odometer_std.is_none()
-    {
-        a.odometer_std = Some(std.to_string());
-        eprintln!(
-            "{path}: odometer noise from its twist covariances: {std} m/s (--odometer-std overrides)"
-        );
-    }
-}
-
-/// `schuler nav --bag`.
-pub fn run(mut plan: NavPlan) -> Result<()> {
-    let args = plan.bag.clone();
-    let Some(path) = &args.bag else {
-        bail!("--bag is missing");
-    };
-    let started = Instant::now();
-    let options = read_options(&plan, &args, plan.axes_given)?;
-    let bag = plan_bag(path, &options)?;
-    describe(&bag);
-    noise_of_variances(&mut plan, &bag);
-    if let Some(week) = bag.clock.week() {
-        let given = plan.settings.week;
-        if given != 0 && given != week {
-            bail!("--week {given}: the bag's UNIX stamps are in GPS week {week}");
-        }
-        plan.settings.week = week;
-    }
-    if let Some(out) = plan.settings.out_bag.as_mut() {
-        out.clock = bag.clock;
-    }
-    plan.aiding.bag = Some(bag.aids.clone());
-    let mut noise = filter_grade(&plan).noise()?;
-    if let Some((arw, vrw)) = bag.imu_noise {
-        // The flags override the covariances (applied in resolve).
-        noise.arw = arw;
-        noise.vrw = vrw;
-        eprintln!(
-            "{}: IMU noise from its covariances: ARW {:.4} deg/sqrt(h), VRW {:.4} m/s/sqrt(h) (largest axis; --arw, --vrw override)",
-            path.display(),
-            arw.max().to_degrees() * 60.0,
-            vrw.max() * 60.0
-        );
-    }
-    let mut aiding = plan.aiding.resolve(noise)?;
-    let mut samples = bag.imu_samples()?;
-    let bar = ProgressBar::hidden();
-    let summary = navigate_samples(&plan, &mut aiding, &mut samples, &bar, |_| {})?;
-    let secs = started.elapsed().as_secs_f64();
-    let gaps = samples.gaps();
-    if !gaps.is_empty() {
-        eprintln!(
-            "warning: {}: topic {}: {gaps}",
-            path.display(),
-            samples.topic()
-        );
-    }
-    print_summary(&plan, aiding.as_ref(), &summary, secs)
-}
-
 /// [`plan`] with the error as anyhow's.
-fn plan_bag(path: &std::path::Path, options: &BagReadOptions) -> Result<BagPlan> {
+pub fn plan_bag(path: &std::path::Path, options: &BagReadOptions) -> Result<BagPlan> {
     Ok(plan(path, options)?)
 }

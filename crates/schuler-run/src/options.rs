@@ -264,42 +264,42 @@ fn unit_value(s: &str, dim: Dimension) -> Result<f64, String> {
 }
 
 /// An acceleration with its unit (`1e-3m/s^2`, `100ug`, `1mGal`) in m/s^2.
-pub(crate) fn acceleration(s: &str) -> Result<f64, String> {
+pub fn acceleration(s: &str) -> Result<f64, String> {
     unit_value(s, Dimension::Acceleration)
 }
 
 /// An angular rate with its unit (`0.01deg/h`, `6deg/s`) in rad/s.
-pub(crate) fn angular_rate(s: &str) -> Result<f64, String> {
+pub fn angular_rate(s: &str) -> Result<f64, String> {
     unit_value(s, Dimension::AngularRate)
 }
 
 /// An angle with its unit (`20arcsec`, `180deg`) in rad.
-pub(crate) fn angle(s: &str) -> Result<f64, String> {
+pub fn angle(s: &str) -> Result<f64, String> {
     unit_value(s, Dimension::Angle)
 }
 
 /// A velocity with its unit (`1m/s`, `250kn`) in m/s.
-pub(crate) fn velocity(s: &str) -> Result<f64, String> {
+pub fn velocity(s: &str) -> Result<f64, String> {
     unit_value(s, Dimension::Velocity)
 }
 
 /// A length with its unit (`100m`, `6371km`) in m.
-pub(crate) fn length(s: &str) -> Result<f64, String> {
+pub fn length(s: &str) -> Result<f64, String> {
     unit_value(s, Dimension::Length)
 }
 
 /// A time with its unit (`4h`, `0.1s`) in s.
-pub(crate) fn time(s: &str) -> Result<f64, String> {
+pub fn time(s: &str) -> Result<f64, String> {
     unit_value(s, Dimension::Time)
 }
 
 /// A ratio: a bare number or with `ppm`, `ppb`, `%`.
-pub(crate) fn ratio(s: &str) -> Result<f64, String> {
+pub fn ratio(s: &str) -> Result<f64, String> {
     units::parse_as_or_si(s, Dimension::Dimensionless).map_err(|e| e.to_string())
 }
 
 /// True for a number > 0 (false for NaN).
-pub(crate) fn is_positive(x: f64) -> bool {
+pub fn is_positive(x: f64) -> bool {
     x > 0.0
 }
 

@@ -4,9 +4,9 @@
 
 use super::aggregate::{Aggregate, NeesOverRuns};
 use super::row::{COLUMNS, RunRow, csv};
-use crate::plot::{LineStyle, Plot};
-use crate::report::{Report, Table};
 use anyhow::{Context, Result};
+use schuler_report::html::{Report, Table};
+use schuler_report::plot::{LineStyle, Plot};
 use serde_json::{Value, json};
 use std::path::Path;
 

@@ -7,7 +7,7 @@
 //!   the NEES of position, velocity and attitude (3 dof each) sampled once a second
 //!   ([`schuler::analysis::consistency`]);
 //! - unless `--no-report`, `report.html` (one self-contained file,
-//!   [`crate::report::Report`]) and `report/`, the SVG plots and CSV data behind
+//!   [`schuler_report::html::Report`]) and `report/`, the SVG plots and CSV data behind
 //!   them: position error against the truth (the seed's circular error dS and the
 //!   vertical error, GNSS gaps shaded, the statistics of `schuler compare`), the
 //!   estimated sensor errors with ±3σ bounds (with `--sensor-truth`, their truth),
@@ -24,8 +24,6 @@
 use super::record::{InnovationRow, ReportSample};
 use super::series::{Series, series};
 use super::spilled::Spilled;
-use crate::plot::{LineStyle, Plot};
-use crate::report::{Report, Table};
 use anyhow::{Context, Result};
 use schuler::analysis::consistency::ChiSquareTest;
 use schuler::analysis::errors::NavRecord;
@@ -35,6 +33,8 @@ use schuler::filter::measurement::Kind;
 use schuler::filter::{GnssFix, Layout, SensorEstimates};
 use schuler::session::MechanizationKind;
 use schuler::units::{DEG_PER_H, MGAL, PPM};
+use schuler_report::html::{Report, Table};
+use schuler_report::plot::{LineStyle, Plot};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

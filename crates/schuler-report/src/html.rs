@@ -8,8 +8,8 @@
 //! [`Report::plots_missing_units`] lists the plots that break it.
 //!
 //! ```
-//! use schuler_cli::plot::{LineStyle, Plot};
-//! use schuler_cli::report::{Report, Table};
+//! use schuler_report::plot::{LineStyle, Plot};
+//! use schuler_report::html::{Report, Table};
 //! let mut report = Report::new("Aided navigation <run 1>");
 //! report.paragraph("Forward filter, 15 states.");
 //! let errors = report.section("errors", "Position error");

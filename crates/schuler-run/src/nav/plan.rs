@@ -1,0 +1,248 @@
+//! A navigation run's plan: the flags merged over the configuration file and every
+//! value checked, with the message naming the flag.
+
+use super::args::{InitChoice, NavArgs, NavConfig, load_config};
+use crate::aided::{Aiding, AidingOptions, GivenReadings};
+use crate::alignment::AlignOptions;
+use crate::bag_input::BagArgs;
+use crate::imu_input::ImuInputOptions;
+use crate::navigate::NavSettings;
+use crate::options::{GradeChoice, Triple, rate};
+use anyhow::{Context, Result, anyhow, bail};
+use nalgebra::Vector3;
+use schuler::earth::Geodetic;
+use schuler::rotation::Euler;
+use schuler::session::MechanizationConfig;
+use schuler_io::formats::ImuReadOptions;
+use std::path::{Path, PathBuf};
+
+/// The mechanization options of flags over config, checked.
+fn mechanization_config(args: &NavArgs, cfg: &NavConfig) -> Result<MechanizationConfig> {
+    let choice = args.mechanization.or(cfg.mechanization).unwrap_or_default();
+    let lat = args
+        .auto_latitude
+        .or(cfg.auto_latitude)
+        .unwrap_or(MechanizationConfig::AUTO_LATITUDE_DEG);
+    if !(lat.is_finite() && lat > 0.0 && lat < 90.0) {
+        bail!("--auto-latitude must be between 0 and 90 deg (exclusive), got {lat}");
+    }
+    let hysteresis = args
+        .auto_hysteresis
+        .or(cfg.auto_hysteresis)
+        .unwrap_or(MechanizationConfig::HYSTERESIS_DEG);
+    if !(hysteresis.is_finite() && hysteresis >= 0.0 && hysteresis < lat) {
+        bail!(
+            "--auto-hysteresis must be at least 0 and below --auto-latitude ({lat} deg), \
+             got {hysteresis}"
+        );
+    }
+    Ok(MechanizationConfig {
+        choice: choice.session(),
+        auto_latitude: lat.to_radians(),
+        hysteresis: hysteresis.to_radians(),
+    })
+}
+
+/// A parsed `nav` command line: settings, the optional alignment and the aiding
+/// options (not yet resolved).
+#[derive(Debug, Clone)]
+pub struct NavPlan {
+    /// The run's settings.
+    pub settings: NavSettings,
+    /// Whether to align first (`--align`).
+    pub align: bool,
+    /// How the run starts.
+    pub init: InitChoice,
+    /// The alignment options (`--imu-grade` among them serves the filter too).
+    pub alignment: AlignOptions,
+    /// The aiding options.
+    pub aiding: AidingOptions,
+    /// Whether the IMU's axes were given (`--imu-axes`, `--imu-rotation`): a bag's
+    /// IMU is FLU otherwise.
+    pub axes_given: bool,
+    /// The bag flags over the configuration's bag keys.
+    pub bag: BagArgs,
+}
+
+/// The initial position of flags over config, checked.
+fn init_pos(args: &NavArgs, cfg: &NavConfig) -> Result<Geodetic> {
+    let Triple([lat, lon, h]) = args
+        .init_pos
+        .or(cfg.init_pos)
+        .context("no initial position: give --init-pos LAT,LON,H (deg, deg, m)")?;
+    schuler_io::formats::gnss::position_in_domain(lat, lon, h)
+        .map_err(|(_, e)| anyhow!("--init-pos: {e}"))
+}
+
+/// The initial attitude of flags over config (zero when aligning), checked.
+fn init_att(args: &NavArgs, cfg: &NavConfig, align_on: bool) -> Result<Euler> {
+    let Triple([roll, pitch, yaw]) = match (args.init_att.or(cfg.init_att), align_on) {
+        (Some(a), _) => a,
+        (None, true) => Triple([0.0; 3]),
+        (None, false) => bail!(
+            "no initial attitude: give --init-att ROLL,PITCH,YAW (deg), or --align to \
+             align at rest first; free-inertial navigation cannot start without one"
+        ),
+    };
+    if !(-90.0..=90.0).contains(&pitch) {
+        bail!("--init-att: pitch {pitch} deg is outside [-90, 90]");
+    }
+    Ok(Euler::from_degrees(roll, pitch, yaw))
+}
+
+/// The IMU reader's options of flags over config, checked.
+fn read_options(args: &NavArgs, cfg: &NavConfig) -> Result<ImuReadOptions> {
+    let (start, end) = (args.start.or(cfg.start), args.end.or(cfg.end));
+    if let (Some(s), Some(e)) = (start, end)
+        && s >= e
+    {
+        bail!("--start {s} is not before --end {e}");
+    }
+    args.input
+        .clone()
+        .or(cfg.input.clone())
+        .read_options(start, end)
+}
+
+/// Merge flags over the config file and check every value (see [`NavPlan`]).
+pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
+    // A value may come from the configuration file: its errors name it.
+    match args.config.clone() {
+        Some(config) => plan(args).with_context(|| format!("with --config {}", config.display())),
+        None => plan(args),
+    }
+}
+
+/// [`parse_nav_args`] itself.
+fn plan(args: NavArgs) -> Result<NavPlan> {
+    let cfg = match &args.config {
+        Some(p) => load_config(p)?,
+        None => NavConfig::default(),
+    };
+    let align_on = args.align || cfg.align.unwrap_or(false);
+    let init = args.init.or(cfg.init).unwrap_or_default();
+    // In motion the fixes give the position and the course (or the bank) the attitude.
+    let in_motion = init != InitChoice::Given;
+    if in_motion && align_on {
+        bail!("--init gnss starts in motion; --align starts at rest: give one of them");
+    }
+    let input = args.input.clone().or(cfg.input.clone());
+    let axes_given = input.imu_axes.is_some() || input.imu_rotation.is_some();
+    let bag = args.bag.clone().or(cfg.bag_args());
+    if bag.bag.is_some() {
+        check_bag_input(&input)?;
+        if args.imu.is_some() || cfg.imu.is_some() {
+            bail!("an IMU log and a bag are both given (--imu or `imu`, --bag or `bag`): give one");
+        }
+    }
+    let settings = NavSettings {
+        imu: args
+            .imu
+            .clone()
+            .or(cfg.imu.clone())
+            .or(bag.bag.clone())
+            .context(
+                "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config) or --bag BAG",
+            )?,
+        read: read_options(&args, &cfg)?,
+        init_pos: if in_motion {
+            Geodetic::new(0.0, 0.0, 0.0)
+        } else {
+            init_pos(&args, &cfg)?
+        },
+        init_vel: Vector3::from(args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3])).0),
+        init_att: init_att(&args, &cfg, align_on || in_motion)?,
+        output_rate: rate("output-rate", args.output_rate.or(cfg.output_rate))?,
+        out: args
+            .out
+            .clone()
+            .or(cfg.out.clone())
+            .unwrap_or_else(|| PathBuf::from(".")),
+        earth: args
+            .earth
+            .or(cfg.earth)
+            .unwrap_or_default()
+            .with_gravity(args.gravity.or(cfg.gravity))
+            .map_err(anyhow::Error::msg)?,
+        week: args.week.or(cfg.week).unwrap_or(0),
+        mechanization: mechanization_config(&args, &cfg)?,
+        out_bag: bag
+            .out_bag
+            .clone()
+            .map(|path| schuler_io::bag::output::OutBag {
+                path,
+                clock: Default::default(),
+            }),
+    };
+    let alignment = args
+        .alignment
+        .clone()
+        .or(cfg.alignment.clone().unwrap_or_default());
+    let base = args
+        .config
+        .as_deref()
+        .and_then(Path::parent)
+        .unwrap_or(Path::new(""));
+    let aiding = args
+        .aiding
+        .or(cfg.aiding.unwrap_or_default().relative_to(base));
+    Ok(NavPlan {
+        settings,
+        align: align_on,
+        init,
+        alignment,
+        aiding,
+        axes_given,
+        bag,
+    })
+}
+
+/// The IMU input options that say how a text log is laid out have no meaning for a
+/// bag (its messages say it): refused rather than ignored.
+fn check_bag_input(input: &ImuInputOptions) -> Result<()> {
+    for (given, flag) in [
+        (input.imu_format.is_some(), "--imu-format"),
+        (input.imu_layout.is_some(), "--imu-layout"),
+        (input.imu_columns.is_some(), "--imu-columns"),
+        (input.gyro_unit.is_some(), "--gyro-unit"),
+        (input.accel_unit.is_some(), "--accel-unit"),
+        (input.imu_time_unit.is_some(), "--imu-time-unit"),
+        (input.imu_rate.is_some(), "--imu-rate"),
+    ] {
+        if given {
+            bail!(
+                "{flag} does not apply to --bag: sensor_msgs/Imu holds rates in rad/s and \
+                 m/s^2 with header stamps"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The filter's IMU grade: `--imu-grade`, else navigation grade for alignment
+/// (gyrocompassing needs it) but tactical for the filter (`aided`): an optimistic
+/// noise model makes the gate refuse good fixes, a pessimistic one only costs a
+/// little accuracy.
+fn grade(alignment: &AlignOptions, aided: bool) -> GradeChoice {
+    alignment.imu_grade.unwrap_or(if aided {
+        GradeChoice::Tactical
+    } else {
+        GradeChoice::Navigation
+    })
+}
+
+/// The filter's IMU grade of a plan ([`grade`]).
+pub fn filter_grade(plan: &NavPlan) -> GradeChoice {
+    grade(&plan.alignment, plan.aiding.any())
+}
+
+/// The run's aiding, if any: the options resolved (files read, or the `given`
+/// readings) with the noise model of `--imu-grade`.
+pub fn resolve_aiding(
+    alignment: &AlignOptions,
+    aiding: &AidingOptions,
+    given: GivenReadings,
+) -> Result<Option<Aiding>> {
+    let noise = grade(alignment, aiding.any() || given.any()).noise()?;
+    aiding.resolve_with(noise, given)
+}
