@@ -19,24 +19,24 @@ enum Command {
     /// barometer, vehicle aids), from a given start, an alignment or in motion.
     Nav(schuler_run::nav::NavArgs),
     /// Initial alignment at rest: gyrocompassing, then the Kalman filter on invariants.
-    Align(schuler_cli::commands::align::Args),
+    Align(schuler_run::alignment::AlignArgs),
     /// A first end-to-end run on built-in simulated data.
     Demo(schuler_cli::commands::demo::DemoArgs),
     /// Simulate a trajectory and its IMU, GNSS and barometer data.
     Simulate(schuler_cli::commands::simulate::Args),
     /// The textbook's single-channel INS/SINS: nonlinear, linear and closed-form errors.
-    Channel(schuler_cli::commands::channel::Args),
+    Channel(schuler_run::channel::Args),
     /// The vertical channel: free, baro-aided, with faults and prediction.
     Vertical(schuler_cli::commands::vertical::Args),
     /// Lecture 22's systems on one trajectory: SINS, platform INS (geographic,
     /// orthodromic, free-azimuth), analytic INS and gyro-free INS, errors compared.
     Platform(schuler_cli::commands::platform::Args),
     /// Errors of a navigation result (KF-GINS text or CSV) against a truth file.
-    Compare(schuler_cli::commands::compare::Args),
+    Compare(schuler_run::compare::Args),
     /// ROS 2 bags (MCAP): `bag info FILE` lists topics, types, counts, rates, spans.
     Bag(schuler_cli::commands::bag::Args),
     /// Noise of a static IMU log: Allan deviations, IEEE 952 terms, nav's noise config.
-    Allan(schuler_cli::commands::allan::Args),
+    Allan(schuler_run::allan::Args),
     /// Monte-Carlo campaign: N seeds of a scenario simulated, navigated and compared
     /// on every core; a table of one row per run and a report.
     Montecarlo(schuler_cli::commands::montecarlo::Args),

@@ -1,6 +1,6 @@
 //! `align(imu, pos=...)`: `schuler align` (coarse gyrocompassing, then the Kalman
 //! filter on the invariants) on a log at rest, from a file or arrays, with the CLI's
-//! own options and code ([`schuler_cli::commands::align`],
+//! own options and code ([`schuler_run::alignment`],
 //! [`schuler_run::alignment`]); what it gives is `align.json`'s content, the
 //! `align_convergence.csv` table and the printed report. The same tables describe the
 //! alignment of `navigate(..., align=True)`.
@@ -12,8 +12,8 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use schuler::align::Alignment;
-use schuler_cli::commands::align::{Args, setup};
 use schuler_io::formats::ImuReader;
+use schuler_run::alignment::{AlignArgs, setup};
 use schuler_run::alignment::{align_on, convergence_row, read_stage, summary_text, to_json};
 use schuler_run::nav::Began;
 
@@ -22,7 +22,7 @@ use schuler_run::nav::Began;
 #[command(name = "align", no_binary_name = true)]
 struct AlignFlags {
     #[command(flatten)]
-    args: Args,
+    args: AlignArgs,
 }
 
 /// Aligns as `schuler align` with `flags` (`--imu` names the file, or a placeholder

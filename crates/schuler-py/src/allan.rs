@@ -72,7 +72,7 @@ pub fn allan<'py>(
 #[command(name = "allan", no_binary_name = true)]
 struct AllanFlags {
     #[command(flatten)]
-    args: schuler_cli::commands::allan::Args,
+    args: schuler_run::allan::Args,
 }
 
 /// `schuler allan` with `flags` (the IMU file first, or a placeholder name when the
@@ -89,7 +89,7 @@ pub fn allan_fit<'py>(
     imu: Option<Vec<PyReadonlyArray1<'py, f64>>>,
     imu_dt: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use schuler_cli::commands::allan as cli;
+    use schuler_run::allan as analysis;
     let args = <AllanFlags as clap::Parser>::try_parse_from(&flags)
         .py_err(py)?
         .args;
@@ -127,16 +127,16 @@ pub fn allan_fit<'py>(
             };
             let allan = ImuAllan::from_samples(&samples, &options)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", args.imu.display()))?;
-            warnings.extend(cli::static_warnings(&args.imu, &samples, &allan));
-            let fits = cli::fit_channels(&allan);
+            warnings.extend(analysis::static_warnings(&args.imu, &samples, &allan));
+            let fits = analysis::fit_channels(&allan);
             Ok((allan, fits, warnings))
         })
         .py_err(py)?;
     let d = PyDict::new(py);
     d.set_item("curves", curves(py, &allan, &fits)?)?;
     d.set_item("fits", fit_rows(py, &fits)?)?;
-    d.set_item("report", cli::summary(&args.imu, &allan, &fits))?;
-    d.set_item("noise_toml", cli::noise_toml(&args.imu, &allan, &fits))?;
+    d.set_item("report", analysis::summary(&args.imu, &allan, &fits))?;
+    d.set_item("noise_toml", analysis::noise_toml(&args.imu, &allan, &fits))?;
     d.set_item("warnings", warnings)?;
     Ok(d)
 }
@@ -146,7 +146,7 @@ pub fn allan_fit<'py>(
 fn curves<'py>(
     py: Python<'py>,
     allan: &ImuAllan,
-    fits: &[schuler_cli::commands::allan::ChannelFit],
+    fits: &[schuler_run::allan::ChannelFit],
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let p0 = &allan.channels[0].points;
@@ -156,7 +156,7 @@ fn curves<'py>(
         let (base, unit) = name.rsplit_once('_').unwrap_or((name, ""));
         let curve = &allan.channels[c];
         let ieee = fits[c].ieee.as_ref();
-        let iv = schuler_cli::commands::allan::point_intervals(curve, ieee);
+        let iv = schuler_run::allan::point_intervals(curve, ieee);
         let fit = |tau: f64| ieee.map_or(f64::NAN, |f| f.avar(tau).sqrt());
         let pts = &curve.points;
         d.set_item(*name, pts.iter().map(|p| p.adev()).collect::<Vec<_>>())?;
@@ -182,7 +182,7 @@ fn curves<'py>(
 /// m/s^2/sqrt(s), m/s for accelerometers; s for `T`) and the fit's `chi2_per_dof`.
 fn fit_rows<'py>(
     py: Python<'py>,
-    fits: &[schuler_cli::commands::allan::ChannelFit],
+    fits: &[schuler_run::allan::ChannelFit],
 ) -> PyResult<Bound<'py, PyDict>> {
     use schuler::analysis::allan::fit::Term;
     let (mut channel, mut model, mut term) = (Vec::new(), Vec::new(), Vec::new());

@@ -1,6 +1,6 @@
 //! The textbook's single channel: `channel(...)` runs `schuler channel` (the nonlinear
 //! system, the linear error model and the closed form side by side, with the CLI's
-//! options and checks, [`schuler_cli::commands::channel`]) and `closed_form(t, ...)`
+//! options and checks, [`schuler_run::channel`]) and `closed_form(t, ...)`
 //! evaluates the general solution (18)/(19) of the error equations (13) for constant
 //! errors and the free vertical channel (32) at any times
 //! ([`schuler::channel::closed`]).
@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 use schuler::channel::closed::{ConstantErrors, response, vertical_free_response};
 use schuler::channel::linear::{ErrorModel, ErrorState};
 use schuler::channel::run::simulate;
-use schuler_cli::commands::channel::{Args, config, explain, summary};
+use schuler_run::channel::{Args, config, explain, summary};
 
 /// Columns of the channel's errors (`errors.csv`'s, units in the names; the
 /// closed form's NaN where the inputs are not constant).

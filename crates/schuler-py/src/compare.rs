@@ -10,9 +10,9 @@ use pyo3::types::PyDict;
 use schuler::analysis::errors::NavRecord;
 use schuler::earth::Geodetic;
 use schuler::rotation::Euler;
-use schuler_cli::commands::compare::summary_json;
 use schuler_io::formats::nav::{NavFormat, read_nav};
 use schuler_io::output::error_fields;
+use schuler_run::compare::summary_json;
 use std::path::{Path, PathBuf};
 
 /// Columns of the errors (`errors.csv`'s, units in the names).

@@ -2,7 +2,8 @@
 //! written, reading the stage's samples, running the library's alignment on the
 //! chosen Earth model, and its report, `align.json` and convergence files.
 
-use crate::options::{EarthChoice, GradeChoice};
+use crate::imu_input::ImuInputOptions;
+use crate::options::{EarthChoice, GradeChoice, Triple};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, AlignError, Alignment, HeadingSource, MotionReport, align};
@@ -14,7 +15,7 @@ use schuler::units::{DEG_PER_H, Dimension, MGAL, parse_as_or_si};
 use schuler_report::plot::{LineStyle, Plot};
 use serde::Deserialize;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The alignment options shared by `align` and `nav --align`, as written.
 #[derive(clap::Args, Debug, Default, Clone, Deserialize)]
@@ -403,4 +404,39 @@ pub fn write_outputs(dir: &Path, a: &Alignment) -> Result<()> {
     .line("pitch", &t, &col(1), LineStyle::Dashed)
     .line("yaw", &t, &col(2), LineStyle::Dotted)
     .write(&dir.join("align_convergence.svg"))
+}
+/// Arguments of `schuler align`.
+#[derive(clap::Args, Debug)]
+pub struct AlignArgs {
+    /// IMU log recorded at rest (KF-GINS text or CSV).
+    #[arg(long, value_name = "FILE")]
+    pub imu: PathBuf,
+    /// Position of the base: latitude [deg], longitude [deg], height [m].
+    #[arg(long, value_name = "LAT,LON,H", allow_hyphen_values = true)]
+    pub pos: Triple,
+    /// Alignment options.
+    #[command(flatten)]
+    pub options: AlignOptions,
+    /// Start time [s, the log's clock] (default: the first sample).
+    #[arg(long, value_name = "SOW")]
+    pub start: Option<f64>,
+    /// Output directory for align.json, align_convergence.csv and .svg.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Earth model.
+    #[arg(long, value_enum, default_value = "wgs84")]
+    pub earth: EarthChoice,
+    /// How to read the IMU log: format, layout, columns, units, clock, axes.
+    #[command(flatten)]
+    pub input: ImuInputOptions,
+}
+
+/// The checked configuration, noise model and base position of `args`.
+pub fn setup(args: &AlignArgs) -> Result<(AlignConfig, ImuNoise, Geodetic)> {
+    let (cfg, noise) = args.options.resolve()?;
+    let Triple([lat, lon, h]) = args.pos;
+    if !(-90.0..=90.0).contains(&lat) {
+        bail!("--pos: latitude {lat} deg is outside [-90, 90]");
+    }
+    Ok((cfg, noise, Geodetic::from_degrees(lat, lon, h)))
 }

@@ -11,8 +11,11 @@
 
 pub mod aided;
 pub mod alignment;
+pub mod allan;
 pub mod bag_input;
 pub mod campaign;
+pub mod channel;
+pub mod compare;
 pub mod drive;
 pub mod imu_input;
 pub mod interrupt;

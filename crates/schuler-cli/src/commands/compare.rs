@@ -1,75 +1,11 @@
 //! `schuler compare NAV TRUTH [--out DIR] [--start T] [--end T] [--outages T0-T1,...]`:
-//! errors of any navigation result (schuler's, KF-GINS's, another tool's) against a
-//! truth file, as a table, `compare.json`, `errors.csv` and SVG plots.
-//!
-//! The file formats are [`schuler_io::formats::nav`]'s; the matching, the errors and the
-//! statistics are the library's ([`schuler::analysis::errors`],
-//! [`schuler::analysis::statistics`]), shared with the aided run's report.
+//! errors of any navigation result against a truth file ([`schuler_run::compare`]),
+//! printed as a table; `compare.json`, `errors.csv` and SVG plots with `--out`.
 
-use anyhow::{Context, Result};
-use schuler::analysis::errors::EpochErrors;
-use schuler::analysis::statistics::{Comparison, OutageMax, QUANTITIES, Quantity, compare};
-use schuler_io::formats::nav::{NavFormat, read_nav};
-use schuler_io::output::write_errors_csv;
-use schuler_report::plot::{LineStyle, Plot};
-use serde_json::{Value, json};
+use anyhow::Result;
+use schuler::analysis::statistics::{Comparison, OutageMax, QUANTITIES, Quantity};
+use schuler_run::compare::{Args, compare_files, write_outputs};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-
-/// Arguments of `schuler compare`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// Navigation result: KF-GINS text (`week sow lat lon h vn ve vd roll pitch yaw`)
-    /// or schuler's nav.csv.
-    #[arg(value_name = "NAV")]
-    pub nav: PathBuf,
-    /// Truth, in either format; interpolated in time where its epochs differ.
-    #[arg(value_name = "TRUTH")]
-    pub truth: PathBuf,
-    /// Output directory for compare.json, errors.csv and the plots (created if
-    /// missing); without it only the table is printed.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// Compare NAV epochs from this time on [s of week].
-    #[arg(long, value_name = "SOW")]
-    pub start: Option<f64>,
-    /// Compare NAV epochs up to this time [s of week].
-    #[arg(long, value_name = "SOW")]
-    pub end: Option<f64>,
-    /// GNSS outage intervals [s of week], e.g. `215-276,400-460`: the largest errors
-    /// inside each and the RMS of those maxima.
-    #[arg(long, value_name = "T0-T1,...", value_parser = parse_outages)]
-    pub outages: Option<Outages>,
-}
-
-/// Time intervals `[from, to]` [s of week], as `--outages` gives them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Outages(pub Vec<(f64, f64)>);
-
-/// Parses `T0-T1,T2-T3` (each `T0 < T1`, finite).
-pub fn parse_outages(text: &str) -> Result<Outages, String> {
-    let mut out = Vec::new();
-    for part in text.split(',').map(str::trim) {
-        // The separating '-' is not a leading sign nor an exponent's sign.
-        let bytes = part.as_bytes();
-        let dash = (1..bytes.len())
-            .find(|&i| bytes[i] == b'-' && !matches!(bytes[i - 1], b'e' | b'E' | b'-'))
-            .ok_or_else(|| format!("{part:?}: expected an interval T0-T1"))?;
-        let (a, b) = (part[..dash].trim(), part[dash + 1..].trim());
-        let num = |s: &str| -> Result<f64, String> {
-            s.parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("{part:?}: {s:?} is not a time in seconds"))
-        };
-        let (from, to) = (num(a)?, num(b)?);
-        if from >= to {
-            return Err(format!("{part:?}: the interval must end after it starts"));
-        }
-        out.push((from, to));
-    }
-    Ok(Outages(out))
-}
 
 /// Decimals printed for a unit.
 fn decimals(unit: &str) -> usize {
@@ -86,10 +22,19 @@ fn cell(x: f64, d: usize) -> String {
     }
 }
 
-/// The report printed: what was matched, then one row per quantity.
+/// The report printed: what was matched, one row per quantity, the CEP, then the
+/// outages' maxima.
 pub fn table(c: &Comparison) -> String {
-    let m = &c.matching;
     let mut s = String::new();
+    matching(&mut s, c);
+    statistics(&mut s, c);
+    outages(&mut s, c);
+    s
+}
+
+/// What was matched, on one line.
+fn matching(s: &mut String, c: &Comparison) {
+    let m = &c.matching;
     let _ = writeln!(
         s,
         "{} epochs compared ({} exact, {} with the truth interpolated{}); skipped: {} before \
@@ -110,6 +55,10 @@ pub fn table(c: &Comparison) -> String {
         m.after_truth,
         m.outside_window
     );
+}
+
+/// One row per quantity (RMS, max, its time, 95 %, mean), then the CEP.
+fn statistics(s: &mut String, c: &Comparison) {
     let _ = writeln!(
         s,
         "\n{:<16} {:<4} {:>12} {:>12} {:>12} {:>12} {:>12}",
@@ -133,6 +82,11 @@ pub fn table(c: &Comparison) -> String {
         "\nCEP (50 % of horizontal errors) {:.4} m, CEP95 {:.4} m",
         c.stats.cep, c.stats.cep95
     );
+}
+
+/// The largest errors in each outage and the RMS of those maxima, if outages were
+/// given.
+fn outages(s: &mut String, c: &Comparison) {
     if !c.stats.outages.is_empty() {
         let _ = writeln!(
             s,
@@ -161,145 +115,22 @@ pub fn table(c: &Comparison) -> String {
             if o.epochs == 0 {
                 let _ = writeln!(s, "{:<21} {:>7} (no epoch inside)", interval(o), 0);
             } else {
-                row(&mut s, interval(o), o);
+                row(s, interval(o), o);
             }
         }
         if let Some(r) = &c.stats.outage_rms {
-            row(&mut s, "RMS of the maxima".to_owned(), r);
+            row(s, "RMS of the maxima".to_owned(), r);
         }
     }
-    s
 }
 
 fn interval(o: &OutageMax) -> String {
     format!("{}-{}", o.from_sow, o.to_sow)
 }
 
-/// `compare.json`: inputs, matching, statistics (attitude in degrees).
-pub fn summary_json(c: &Comparison, nav: (&Path, NavFormat), truth: (&Path, NavFormat)) -> Value {
-    let m = &c.matching;
-    let mut stats = serde_json::Map::new();
-    for (Quantity { name, unit, .. }, q) in QUANTITIES.iter().zip(&c.stats.summaries) {
-        let key = format!(
-            "{}_{}",
-            name.replace(" (down)", "").replace([' ', '-'], "_"),
-            unit.replace('/', "p")
-        )
-        .to_lowercase();
-        stats.insert(
-            key,
-            json!({"rms": q.rms, "max": q.max_abs, "t_max_sow": q.t_max_sow,
-                   "p95": q.p95_abs, "mean": q.mean}),
-        );
-    }
-    stats.insert("cep_m".to_owned(), json!(c.stats.cep));
-    stats.insert("cep95_m".to_owned(), json!(c.stats.cep95));
-    let outage = |o: &OutageMax| {
-        json!({
-            "from_sow": o.from_sow, "to_sow": o.to_sow, "epochs": o.epochs,
-            "max_horizontal_m": (o.epochs > 0).then_some(o.horizontal),
-            "max_vertical_m": (o.epochs > 0).then_some(o.vertical),
-            "max_roll_deg": (o.epochs > 0).then_some(o.att.roll.to_degrees()),
-            "max_pitch_deg": (o.epochs > 0).then_some(o.att.pitch.to_degrees()),
-            "max_yaw_deg": (o.epochs > 0).then_some(o.att.yaw.to_degrees()),
-        })
-    };
-    json!({
-        "nav": {"path": nav.0.display().to_string(), "format": nav.1.name()},
-        "truth": {"path": truth.0.display().to_string(), "format": truth.1.name()},
-        "epochs": {
-            "matched": m.matched(), "exact": m.exact, "interpolated": m.interpolated,
-            "before_truth": m.before_truth, "after_truth": m.after_truth,
-            "outside_window": m.outside_window, "max_bridged_s": m.max_bridged_s,
-        },
-        "statistics": Value::Object(stats),
-        "outages": c.stats.outages.iter().map(outage).collect::<Vec<_>>(),
-        "outage_rms": c.stats.outage_rms.as_ref().map(|r| json!({
-            "outages": r.epochs,
-            "horizontal_m": r.horizontal, "vertical_m": r.vertical,
-            "roll_deg": r.att.roll.to_degrees(), "pitch_deg": r.att.pitch.to_degrees(),
-            "yaw_deg": r.att.yaw.to_degrees(),
-        })),
-    })
-}
-
-/// Writes the three plots: position, velocity and attitude errors against time, the
-/// outage intervals shaded.
-fn write_plots(dir: &Path, c: &Comparison) -> Result<()> {
-    let t: Vec<f64> = c.errors.iter().map(|e| e.t_sow).collect();
-    let col = |f: &dyn Fn(&EpochErrors) -> f64| c.errors.iter().map(f).collect::<Vec<f64>>();
-    let spans: Vec<(f64, f64)> = c
-        .stats
-        .outages
-        .iter()
-        .map(|o| (o.from_sow, o.to_sow))
-        .collect();
-    let shade = |p: Plot| {
-        if spans.is_empty() {
-            p
-        } else {
-            p.shade("outage", spans.iter().copied())
-        }
-    };
-    shade(
-        Plot::new("Position error", "t [s of week]", "error [m]")
-            .line(
-                "horizontal",
-                &t,
-                &col(&EpochErrors::horizontal),
-                LineStyle::Solid,
-            )
-            .line("down", &t, &col(&|e| e.pos_n.z), LineStyle::Dashed),
-    )
-    .write(&dir.join("position_error.svg"))?;
-    shade(
-        Plot::new("Velocity error", "t [s of week]", "error [m/s]")
-            .line("north", &t, &col(&|e| e.v_n.x), LineStyle::Solid)
-            .line("east", &t, &col(&|e| e.v_n.y), LineStyle::Dashed)
-            .line("down", &t, &col(&|e| e.v_n.z), LineStyle::Dotted),
-    )
-    .write(&dir.join("velocity_error.svg"))?;
-    shade(
-        Plot::new("Attitude error", "t [s of week]", "error [deg]")
-            .line(
-                "roll",
-                &t,
-                &col(&|e| e.att.roll.to_degrees()),
-                LineStyle::Solid,
-            )
-            .line(
-                "pitch",
-                &t,
-                &col(&|e| e.att.pitch.to_degrees()),
-                LineStyle::Dashed,
-            )
-            .line(
-                "yaw",
-                &t,
-                &col(&|e| e.att.yaw.to_degrees()),
-                LineStyle::Dotted,
-            ),
-    )
-    .write(&dir.join("attitude_error.svg"))
-}
-
 /// Runs `schuler compare`.
 pub fn run(args: Args) -> Result<()> {
-    if let (Some(s), Some(e)) = (args.start, args.end)
-        && s > e
-    {
-        anyhow::bail!("--start {s} is after --end {e}");
-    }
-    let (nav_format, nav) = read_nav(&args.nav)?;
-    let (truth_format, truth) = read_nav(&args.truth)?;
-    let outages = args.outages.map(|o| o.0).unwrap_or_default();
-    let c = compare(&nav, &truth, args.start, args.end, &outages).with_context(|| {
-        format!(
-            "comparing {} with {}",
-            args.nav.display(),
-            args.truth.display()
-        )
-    })?;
+    let (c, nav_format, truth_format) = compare_files(&args)?;
     println!(
         "{} ({}) against {} ({})",
         args.nav.display(),
@@ -309,13 +140,7 @@ pub fn run(args: Args) -> Result<()> {
     );
     print!("{}", table(&c));
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        let json = summary_json(&c, (&args.nav, nav_format), (&args.truth, truth_format));
-        let text = serde_json::to_string_pretty(&json).context("encoding compare.json")?;
-        let path = dir.join("compare.json");
-        schuler_io::line_file::write_whole(&path, text + "\n")?;
-        write_errors_csv(&dir.join("errors.csv"), &c.errors)?;
-        write_plots(dir, &c)?;
+        write_outputs(dir, &args, &c, [nav_format, truth_format])?;
         println!(
             "\nwrote compare.json, errors.csv, position_error.svg, velocity_error.svg, \
              attitude_error.svg to {}",
@@ -323,24 +148,4 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn outages_parse_and_reject_nonsense() {
-        assert_eq!(
-            parse_outages("215-276, 400.5-460").expect("parses").0,
-            vec![(215.0, 276.0), (400.5, 460.0)]
-        );
-        assert_eq!(
-            parse_outages("1e2-2e+2").expect("exponents").0,
-            vec![(100.0, 200.0)]
-        );
-        for bad in ["215", "276-215", "a-b", "1-", ""] {
-            assert!(parse_outages(bad).is_err(), "{bad:?}");
-        }
-    }
 }
