@@ -480,6 +480,52 @@ fn writer_error(pipe: WriterThread) -> anyhow::Error {
     }
 }
 
+/// The loop of [`drive`]: each sample pushed after the aids due before it, what comes
+/// out handed to the writer thread, the snapshots kept every 65,536 samples. Stops at
+/// the end of the input, at a sample that fails or at a signal; returns the count
+/// pushed and what stopped it, `None` when the writer thread stopped.
+fn push_samples<M: EarthModel, I, E>(
+    (session, feed, pipe, snapshots): Pushing<'_, '_, M>,
+    samples: I,
+    on_sample: &mut impl FnMut(u64),
+) -> Option<(u64, Option<anyhow::Error>)>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
+    let mut n = 0u64;
+    for s in samples {
+        // A signal stops the run here, as a read error does: everything before is
+        // written, every file ends on a whole line.
+        if let Some(i) = crate::interrupt::requested() {
+            return Some((n, Some(i.into())));
+        }
+        let pushed = s.map_err(anyhow::Error::new).and_then(|s| {
+            feed.before(session, &s)?;
+            session.push_imu(s).map_err(anyhow::Error::new)
+        });
+        if let Err(e) = pushed {
+            return Some((n, Some(e)));
+        }
+        pipe.take(session).ok()?;
+        n += 1;
+        if n.is_multiple_of(65_536) {
+            on_sample(n);
+            session.snapshots().for_each(|x| snapshots.push(&x));
+        }
+    }
+    Some((n, None))
+}
+
+/// What [`push_samples`] pushes through: the session, the aids, the writer thread and
+/// the snapshots kept.
+type Pushing<'a, 'f, M> = (
+    &'a mut Session<M>,
+    &'a mut AidFeed<'f>,
+    &'a mut WriterThread,
+    &'a mut Spilled<Snapshot>,
+);
+
 /// Pushes `samples` into `session`, each after the aids `feed` has due before it
 /// ([`AidFeed`]), writing what comes out to `out` on a writer thread
 /// ([`WriterThread`]) and keeping the filter's snapshots as they come (in
@@ -500,33 +546,11 @@ where
     E: std::error::Error + Send + Sync + 'static,
 {
     let mut pipe = WriterThread::spawn(out)?;
-    let mut n = 0u64;
-    let mut failure: Option<anyhow::Error> = None;
     let mut snapshots = Spilled::default();
-    for s in samples {
-        // A signal stops the run here, as a read error does: everything before is
-        // written, every file ends on a whole line.
-        if let Some(i) = crate::interrupt::requested() {
-            failure = Some(i.into());
-            break;
-        }
-        let pushed = s.map_err(anyhow::Error::new).and_then(|s| {
-            feed.before(&mut session, &s)?;
-            session.push_imu(s).map_err(anyhow::Error::new)
-        });
-        if let Err(e) = pushed {
-            failure = Some(e);
-            break;
-        }
-        if pipe.take(&mut session).is_err() {
-            return Err(writer_error(pipe));
-        }
-        n += 1;
-        if n.is_multiple_of(65_536) {
-            on_sample(n);
-            session.snapshots().for_each(|x| snapshots.push(&x));
-        }
-    }
+    let pushing = (&mut session, &mut feed, &mut pipe, &mut snapshots);
+    let Some((n, mut failure)) = push_samples(pushing, samples, &mut on_sample) else {
+        return Err(writer_error(pipe));
+    };
     if let Err(e) = feed.rest(&mut session) {
         failure.get_or_insert(e);
     }

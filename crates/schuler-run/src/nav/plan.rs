@@ -135,45 +135,7 @@ fn plan(args: NavArgs) -> Result<NavPlan> {
             bail!("an IMU log and a bag are both given (--imu or `imu`, --bag or `bag`): give one");
         }
     }
-    let settings = NavSettings {
-        imu: args
-            .imu
-            .clone()
-            .or(cfg.imu.clone())
-            .or(bag.bag.clone())
-            .context(
-                "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config) or --bag BAG",
-            )?,
-        read: read_options(&args, &cfg)?,
-        init_pos: if in_motion {
-            Geodetic::new(0.0, 0.0, 0.0)
-        } else {
-            init_pos(&args, &cfg)?
-        },
-        init_vel: Vector3::from(args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3])).0),
-        init_att: init_att(&args, &cfg, align_on || in_motion)?,
-        output_rate: rate("output-rate", args.output_rate.or(cfg.output_rate))?,
-        out: args
-            .out
-            .clone()
-            .or(cfg.out.clone())
-            .unwrap_or_else(|| PathBuf::from(".")),
-        earth: args
-            .earth
-            .or(cfg.earth)
-            .unwrap_or_default()
-            .with_gravity(args.gravity.or(cfg.gravity))
-            .map_err(anyhow::Error::msg)?,
-        week: args.week.or(cfg.week).unwrap_or(0),
-        mechanization: mechanization_config(&args, &cfg)?,
-        out_bag: bag
-            .out_bag
-            .clone()
-            .map(|path| schuler_io::bag::output::OutBag {
-                path,
-                clock: Default::default(),
-            }),
-    };
+    let settings = settings(&args, &cfg, &bag, in_motion, align_on)?;
     let alignment = args
         .alignment
         .clone()
@@ -194,6 +156,56 @@ fn plan(args: NavArgs) -> Result<NavPlan> {
         aiding,
         axes_given,
         bag,
+    })
+}
+
+/// The run's settings of flags over config, checked (the IMU log or the bag, the
+/// window, the start, the output, the Earth model and the mechanization).
+fn settings(
+    args: &NavArgs,
+    cfg: &NavConfig,
+    bag: &BagArgs,
+    in_motion: bool,
+    align_on: bool,
+) -> Result<NavSettings> {
+    Ok(NavSettings {
+        imu: args
+            .imu
+            .clone()
+            .or(cfg.imu.clone())
+            .or(bag.bag.clone())
+            .context(
+                "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config) or --bag BAG",
+            )?,
+        read: read_options(args, cfg)?,
+        init_pos: if in_motion {
+            Geodetic::new(0.0, 0.0, 0.0)
+        } else {
+            init_pos(args, cfg)?
+        },
+        init_vel: Vector3::from(args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3])).0),
+        init_att: init_att(args, cfg, align_on || in_motion)?,
+        output_rate: rate("output-rate", args.output_rate.or(cfg.output_rate))?,
+        out: args
+            .out
+            .clone()
+            .or(cfg.out.clone())
+            .unwrap_or_else(|| PathBuf::from(".")),
+        earth: args
+            .earth
+            .or(cfg.earth)
+            .unwrap_or_default()
+            .with_gravity(args.gravity.or(cfg.gravity))
+            .map_err(anyhow::Error::msg)?,
+        week: args.week.or(cfg.week).unwrap_or(0),
+        mechanization: mechanization_config(args, cfg)?,
+        out_bag: bag
+            .out_bag
+            .clone()
+            .map(|path| schuler_io::bag::output::OutBag {
+                path,
+                clock: Default::default(),
+            }),
     })
 }
 
