@@ -9,8 +9,9 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::sim::analytic::{self, Maneuvering};
-use schuler_cli::commands::kf_gins::{KfGinsOptions, run};
+use schuler_cli::commands::kf_gins::run;
 use schuler_io::output::write_imu_text;
+use schuler_run::kf_gins::KfGinsOptions;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 

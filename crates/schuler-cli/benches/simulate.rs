@@ -13,7 +13,7 @@ use schuler::nav::NavState;
 use schuler::sim::analytic::Kinematics;
 use schuler::sim::receivers::{BaroReading, GnssFix};
 use schuler::sim::run::{SimSink, simulate};
-use schuler_cli::commands::simulate::simulate_to_dir;
+use schuler_run::simulate::simulate_to_dir;
 use std::path::PathBuf;
 
 const SCENARIO: &str = r#"

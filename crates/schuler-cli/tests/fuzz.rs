@@ -439,7 +439,7 @@ fn kf_gins(path: &Path, bytes: &[u8]) -> Result<bool, String> {
     std::fs::write(dir.join("GNSS.txt"), &gnss[1]).expect("write GNSS.txt");
     let text = String::from_utf8_lossy(bytes).replace("@DIR@", &dir.to_string_lossy());
     std::fs::write(path, text).expect("write the configuration");
-    let run = schuler_cli::commands::kf_gins::load(path, &Default::default());
+    let run = schuler_run::kf_gins::load(path, &Default::default());
     judged(path, run, |_| Ok(()))
 }
 

@@ -22,7 +22,7 @@ pub fn run_nav(args: schuler_run::nav::NavArgs) -> anyhow::Result<()> {
     match &args.kf_gins_config {
         Some(path) => kf_gins::run(
             path,
-            &kf_gins::KfGinsOptions {
+            &schuler_run::kf_gins::KfGinsOptions {
                 report: args.report,
                 nav_csv: args.nav_csv,
                 gate: args.aiding.gate,

@@ -11,6 +11,7 @@ mod gps_time;
 pub mod imu_columns;
 pub mod imu_log;
 pub mod imu_plausibility;
+pub mod kf_gins_config;
 mod lines;
 mod lines_ahead;
 pub mod nav;
