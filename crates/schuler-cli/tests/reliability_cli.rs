@@ -459,6 +459,24 @@ fn aids_and_parameters_outside_their_domain_are_refused_by_name() {
     }
 }
 
+/// A KF-GINS configuration is read to 16 MiB at most, as every other configuration
+/// file: an endless one (`/dev/zero`, issue 36's item 4) was read without bound.
+#[cfg(unix)]
+#[test]
+fn a_kf_gins_configuration_is_read_to_the_cap() {
+    let o = assert_cmd::Command::cargo_bin("schuler")
+        .expect("binary")
+        .args(["nav", "--kf-gins-config", "/dev/zero"])
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .failure();
+    let stderr = String::from_utf8_lossy(&o.get_output().stderr);
+    assert!(
+        stderr.contains("/dev/zero: longer than 16 MiB: not a configuration file"),
+        "{stderr}"
+    );
+}
+
 /// A navigation result with a velocity of 1.7e308 m/s (the issue's reproducer gave
 /// "RMS inf"): `compare` prints finite statistics, the largest error among them.
 #[test]
