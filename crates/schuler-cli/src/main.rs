@@ -27,10 +27,10 @@ enum Command {
     /// The textbook's single-channel INS/SINS: nonlinear, linear and closed-form errors.
     Channel(schuler_run::channel::Args),
     /// The vertical channel: free, baro-aided, with faults and prediction.
-    Vertical(schuler_cli::commands::vertical::Args),
+    Vertical(schuler_run::vertical::Args),
     /// Lecture 22's systems on one trajectory: SINS, platform INS (geographic,
     /// orthodromic, free-azimuth), analytic INS and gyro-free INS, errors compared.
-    Platform(schuler_cli::commands::platform::Args),
+    Platform(schuler_run::platform::Args),
     /// Errors of a navigation result (KF-GINS text or CSV) against a truth file.
     Compare(schuler_run::compare::Args),
     /// ROS 2 bags (MCAP): `bag info FILE` lists topics, types, counts, rates, spans.

@@ -23,5 +23,7 @@ pub mod kf_gins;
 pub mod nav;
 pub mod navigate;
 pub mod options;
+pub mod platform;
 pub mod scenario;
 pub mod simulate;
+pub mod vertical;
