@@ -5,7 +5,7 @@
 //! bit for bit.
 
 use assert_cmd::Command;
-use schuler_cli::commands::demo::{Crossing, Sortie};
+use schuler_run::demo::{Crossing, Sortie};
 use std::path::Path;
 
 fn run_demo(out: &Path) -> String {

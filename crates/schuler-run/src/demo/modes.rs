@@ -5,7 +5,7 @@
 //! filter on GNSS position and velocity and the barometer; forward, and smoothed).
 
 use super::capture::Recording;
-use indicatif::ProgressBar;
+use crate::progress::Task;
 use nalgebra::Vector3;
 use schuler::channel::detector::DetectorConfig;
 use schuler::channel::vertical::{DetectorCounts, Gains};
@@ -90,7 +90,7 @@ fn run_session(
     start: &Start,
     config: SessionConfig,
     fixes: &[GnssFix],
-    bar: &ProgressBar,
+    bar: &dyn Task,
 ) -> (Track, Finished) {
     let clock = Instant::now();
     let i0 = rec.sample_at(start.state.t);
@@ -160,7 +160,7 @@ pub fn inertial(
     start: &Start,
     gains: Option<Gains>,
     choice: MechanizationChoice,
-    bar: &ProgressBar,
+    bar: &dyn Task,
 ) -> Track {
     let cfg = SessionConfig {
         baro_loop: gains.map(|gains| BaroLoopConfig {
@@ -195,7 +195,7 @@ pub fn aided(
     prior: &Prior,
     settings: &AidedSettings,
     choice: MechanizationChoice,
-    bar: &ProgressBar,
+    bar: &dyn Task,
 ) -> (Track, Result<Track, SpillError>) {
     let integration = IntegrationConfig {
         lever_arm: settings.lever_arm,

@@ -26,8 +26,8 @@
 use super::capture::Recording;
 use super::modes::{self, Start, Track};
 use super::{Alignments, ModeRun, Sortie, errors};
+use crate::progress::Task;
 use anyhow::{Context, Result};
-use indicatif::ProgressBar;
 use schuler::channel::vertical::Gains;
 use schuler::earth::Wgs84;
 use schuler::filter::integration::SensorEstimates;
@@ -90,7 +90,7 @@ pub fn figure3(
     a: &Alignments,
     runs: &[ModeRun],
     gains: Gains,
-    bar: &ProgressBar,
+    bar: &dyn Task,
 ) -> Result<Figure3> {
     let end = rec.truth.last().map_or(0.0, |e| e.state.t);
     let find = |key: &str| super::page::find(runs, key);
@@ -134,7 +134,7 @@ fn leg(
     aided: &Track,
     t0: f64,
     gains: Gains,
-    bar: &ProgressBar,
+    bar: &dyn Task,
 ) -> Result<(ModeRun, SensorEstimates)> {
     let epoch = aided
         .epochs

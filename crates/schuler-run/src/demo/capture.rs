@@ -2,8 +2,8 @@
 //! sensor biases once a second, GNSS fixes and barometer readings; from a scenario
 //! (the sortie) or from an analytic trajectory written in ECEF (the pole crossing).
 
+use crate::progress::Task;
 use anyhow::{Context, Result};
-use indicatif::ProgressBar;
 use nalgebra::Vector3;
 use schuler::earth::{EarthModel, Wgs84};
 use schuler::filter::integration::GnssFix;
@@ -69,14 +69,14 @@ impl Recording {
 struct Capture {
     rec: Recording,
     imu: ImuSimulator,
-    bar: ProgressBar,
+    bar: Box<dyn Task>,
 }
 
 impl Capture {
     /// An empty recording of `samples` samples at `rate` [Hz] of an IMU `model` drawing
     /// from `seed` (the simulator's own model and seed: the same samples, with the
     /// biases behind them in reach).
-    fn new(model: ImuModel, seed: u64, rate: f64, samples: usize, bar: ProgressBar) -> Self {
+    fn new(model: ImuModel, seed: u64, rate: f64, samples: usize, bar: Box<dyn Task>) -> Self {
         Self {
             rec: Recording {
                 rate,
@@ -148,7 +148,7 @@ impl SimSink for Capture {
 }
 
 /// Simulate `spec` into memory, advancing `bar` by one per simulated second.
-pub fn record(spec: &ScenarioSpec, bar: ProgressBar) -> Result<Recording> {
+pub fn record(spec: &ScenarioSpec, bar: Box<dyn Task>) -> Result<Recording> {
     let model = spec.imu.model().context("the sortie's IMU")?;
     let (traj, _) = spec
         .trajectory(schuler::earth::Wgs84)
@@ -186,7 +186,7 @@ pub fn record_trajectory<T: Trajectory>(
     t0: f64,
     duration: f64,
     spec: &ScenarioSpec,
-    bar: ProgressBar,
+    bar: Box<dyn Task>,
 ) -> Result<Recording> {
     let earth = Wgs84;
     let rate = spec.imu.rate_hz;

@@ -7,7 +7,7 @@ use schuler::sim::scenario::{Quantity, SegmentSpec, WaypointSpec};
 use schuler::sim::sensor_spec::GnssOutlierSpec;
 
 /// The full sortie as written (also a `schuler simulate` config).
-pub const POLAR_FLIGHT: &str = include_str!("../../../../../examples/polar_flight.toml");
+pub const POLAR_FLIGHT: &str = include_str!("../../../../examples/polar_flight.toml");
 
 /// The sortie and the timeline its processing follows.
 #[derive(Debug, Clone)]

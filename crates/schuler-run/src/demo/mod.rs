@@ -1,4 +1,4 @@
-//! `schuler demo`: the second seed document's flight test re-enacted end to end.
+//! The second seed document's flight test re-enacted end to end (`schuler demo`).
 //!
 //! A helicopter sortie above the Arctic circle is simulated in memory (FOG-class IMU at
 //! 1 kHz with rotor vibration, GNSS at 1 Hz, barometer; 15 min on the pad and 45 min of
@@ -24,15 +24,15 @@ mod page_polar;
 mod polar;
 mod sortie;
 
+use crate::progress::Progress;
 use anyhow::{Context, Result};
-use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, Alignment, align};
 use schuler::channel::vertical::Gains;
 use schuler::earth::Wgs84;
 use schuler::filter::ImuNoise;
 use schuler::session::MechanizationChoice;
-use std::path::PathBuf;
+use std::path::Path;
 use std::time::Instant;
 
 pub use crossing::Crossing;
@@ -41,18 +41,6 @@ pub use sortie::{POLAR_FLIGHT, Sortie};
 /// The sortie's mechanization: NED (70 N is far from the poles).
 /// The sortie navigates in NED (70° N).
 const NED: MechanizationChoice = MechanizationChoice::Ned;
-
-/// Arguments of `schuler demo`.
-#[derive(clap::Args, Debug)]
-pub struct DemoArgs {
-    /// Output directory.
-    #[arg(long, default_value = "schuler-demo")]
-    pub out: PathBuf,
-    /// A shortened sortie (200 Hz, 5 min on the pad, 7 min of flight) and pole
-    /// crossing (4 min) that run in seconds.
-    #[arg(long)]
-    pub quick: bool,
-}
 
 /// One navigation mode's run and its errors.
 pub struct ModeRun {
@@ -92,17 +80,6 @@ pub struct Alignments {
     pub coarse_only: Alignment,
 }
 
-pub(crate) fn bar(multi: &MultiProgress, name: &str, len: u64) -> ProgressBar {
-    let b = multi.add(ProgressBar::new(len));
-    b.set_style(
-        ProgressStyle::with_template("{prefix:>28} [{bar:30}] {pos:>5}/{len} s  {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    b.set_prefix(name.to_string());
-    b
-}
-
 fn align_both(rec: &capture::Recording, s: &Sortie) -> Result<Alignments> {
     let noise = ImuNoise::from_model(&rec.model);
     let pos = rec.truth[0].state.pos;
@@ -126,11 +103,11 @@ fn align_both(rec: &capture::Recording, s: &Sortie) -> Result<Alignments> {
 
 /// The sortie simulated in memory; returns the recording, the trajectory's span [s]
 /// and the wall-clock time it took [s].
-fn simulate(sortie: &Sortie, multi: &MultiProgress) -> Result<(capture::Recording, f64, f64)> {
+fn simulate(sortie: &Sortie, progress: &dyn Progress) -> Result<(capture::Recording, f64, f64)> {
     let clock = Instant::now();
     let (traj, _) = sortie.spec.trajectory(Wgs84).context("the sortie")?;
     let span = traj.end() - traj.start();
-    let rec = capture::record(&sortie.spec, bar(multi, "simulate", span as u64))?;
+    let rec = capture::record(&sortie.spec, progress.task("simulate", span as u64))?;
     Ok((rec, span, clock.elapsed().as_secs_f64()))
 }
 
@@ -139,10 +116,10 @@ fn simulate(sortie: &Sortie, multi: &MultiProgress) -> Result<(capture::Recordin
 fn align_timed(
     rec: &capture::Recording,
     sortie: &Sortie,
-    multi: &MultiProgress,
+    progress: &dyn Progress,
 ) -> Result<(Alignments, f64)> {
     let clock = Instant::now();
-    let align_bar = bar(multi, "align (coarse, fine)", 2);
+    let align_bar = progress.task("align (coarse, fine)", 2);
     let alignments = align_both(rec, sortie)?;
     align_bar.inc(2);
     align_bar.finish();
@@ -177,16 +154,16 @@ fn navigate_sortie(
     alignments: &Alignments,
     gains: Gains,
     aided_settings: &modes::AidedSettings,
-    multi: &MultiProgress,
+    progress: &dyn Progress,
     flight: u64,
 ) -> Result<Vec<ModeRun>> {
     let fine_start = modes::Start::from_alignment(&alignments.fine);
     let coarse_start = modes::Start::from_alignment(&alignments.coarse_only);
     let bars = [
-        bar(multi, "inertial-satellite (KF)", flight),
-        bar(multi, "inertial, baro loop", flight),
-        bar(multi, "inertial, coarse only", flight),
-        bar(multi, "inertial, no baro", flight),
+        progress.task("inertial-satellite (KF)", flight),
+        progress.task("inertial, baro loop", flight),
+        progress.task("inertial, coarse only", flight),
+        progress.task("inertial, no baro", flight),
     ];
     let ((forward, smoothed), inertial, coarse_only, no_baro) = std::thread::scope(|scope| {
         let aided = scope.spawn(|| {
@@ -234,39 +211,38 @@ fn navigate_sortie(
     .collect())
 }
 
-/// `schuler demo`.
-pub fn run(args: DemoArgs) -> Result<()> {
+/// The demo into `out` (the full sortie, or with `quick` the short one), its progress
+/// told to `progress`; returns the summary for the terminal.
+pub fn run(out: &Path, quick: bool, progress: &dyn Progress) -> Result<String> {
     let started = Instant::now();
-    let sortie = if args.quick {
+    let sortie = if quick {
         Sortie::quick()?
     } else {
         Sortie::full()?
     };
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
-    let (rec, span, simulate_s) = simulate(&sortie, &multi)?;
-    let (alignments, align_s) = align_timed(&rec, &sortie, &multi)?;
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let (rec, span, simulate_s) = simulate(&sortie, progress)?;
+    let (alignments, align_s) = align_timed(&rec, &sortie, progress)?;
     let gains = modes::baro_gains(&modes::Start::from_alignment(&alignments.fine).state)?;
     let settings = aided_settings(&sortie)?;
     let flight = (span - sortie.nav_start()) as u64;
-    let runs = navigate_sortie(&rec, &alignments, gains, &settings, &multi, flight)?;
-    let fig3_bar = bar(&multi, "inertial, figure 3's leg", flight);
+    let runs = navigate_sortie(&rec, &alignments, gains, &settings, progress, flight)?;
+    let fig3_bar = progress.task("inertial, figure 3's leg", flight);
     let fig3 = figure3::figure3(&rec, &sortie, &alignments, &runs, gains, &fig3_bar)?;
     fig3_bar.finish();
 
-    let crossing = if args.quick {
+    let crossing = if quick {
         crossing::Crossing::quick(&sortie)?
     } else {
         crossing::Crossing::full(&sortie)?
     };
-    let polar = polar::run(crossing, &settings, &multi)?;
+    let polar = polar::run(crossing, &settings, progress)?;
     let timing = page::Timing {
         simulate: simulate_s,
         align: align_s,
     };
     let summary = page::write(
-        &args.out,
+        out,
         &sortie,
         &rec,
         &alignments,
@@ -277,7 +253,5 @@ pub fn run(args: DemoArgs) -> Result<()> {
         timing,
         started,
     )?;
-    multi.clear().ok();
-    println!("{summary}");
-    Ok(())
+    Ok(summary)
 }

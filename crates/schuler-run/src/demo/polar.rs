@@ -8,9 +8,9 @@
 use super::capture::{self, Recording};
 use super::crossing::Crossing;
 use super::modes::{self, AidedSettings, Prior, Start};
-use super::{ModeRun, bar, errors};
+use super::{ModeRun, errors};
+use crate::progress::Progress;
 use anyhow::Result;
-use indicatif::MultiProgress;
 use schuler::session::MechanizationChoice;
 use std::time::Instant;
 
@@ -29,8 +29,8 @@ pub struct Polar {
     pub simulate_s: f64,
 }
 
-/// Simulate and navigate `crossing`, with progress bars in `multi`.
-pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) -> Result<Polar> {
+/// Simulate and navigate `crossing`, its progress told to `progress`.
+pub fn run(crossing: Crossing, settings: &AidedSettings, progress: &dyn Progress) -> Result<Polar> {
     let clock = Instant::now();
     let span = crossing.duration as u64;
     let rec = capture::record_trajectory(
@@ -38,7 +38,7 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
         crossing.t0,
         crossing.duration,
         &crossing.spec,
-        bar(multi, "simulate the pole crossing", span),
+        progress.task("simulate the pole crossing", span),
     )?;
     let simulate_s = clock.elapsed().as_secs_f64();
 
@@ -56,9 +56,9 @@ pub fn run(crossing: Crossing, settings: &AidedSettings, multi: &MultiProgress) 
     };
     let gains = modes::baro_gains(&start.state)?;
     let bars = [
-        bar(multi, "pole: wander, satellite", span),
-        bar(multi, "pole: wander, inertial", span),
-        bar(multi, "pole: NED, inertial", span),
+        progress.task("pole: wander, satellite", span),
+        progress.task("pole: wander, inertial", span),
+        progress.task("pole: NED, inertial", span),
     ];
     let ((forward, smoothed), inertial, ned) = std::thread::scope(|scope| {
         let aided = scope.spawn(|| modes::aided(&rec, &start, &prior, settings, WANDER, &bars[0]));
