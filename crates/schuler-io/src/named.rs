@@ -25,11 +25,6 @@ pub trait Named: Copy + PartialEq + 'static {
             .find(|(_, n, _)| *n == name)
             .map(|(v, _, _)| *v)
     }
-
-    /// The names, in order.
-    fn names() -> impl Iterator<Item = &'static str> {
-        Self::VALUES.iter().map(|(_, n, _)| *n)
-    }
 }
 
 /// Checks that `T` lists `all` (every value of the type) once each, under the names

@@ -1,5 +1,5 @@
-//! Progress of a long computation, for a front end to show (the CLI's progress bars)
-//! or for nobody ([`Silent`]): the computation opens named tasks and advances them.
+//! Progress of a long computation, for a front end to show (the CLI's progress bars):
+//! the computation opens named tasks and advances them.
 
 /// One task's progress: advanced a step at a time, finished once.
 pub trait Task: Send + Sync {
@@ -13,20 +13,6 @@ pub trait Task: Send + Sync {
 pub trait Progress: Sync {
     /// A task called `name` of `len` steps.
     fn task(&self, name: &str, len: u64) -> Box<dyn Task>;
-}
-
-/// Progress nobody watches.
-pub struct Silent;
-
-impl Task for Silent {
-    fn inc(&self, _: u64) {}
-    fn finish(&self) {}
-}
-
-impl Progress for Silent {
-    fn task(&self, _: &str, _: u64) -> Box<dyn Task> {
-        Box::new(Silent)
-    }
 }
 
 /// A boxed task is a task (what [`Progress::task`] gives can be lent as `&dyn Task`).
