@@ -11,6 +11,7 @@ pub mod channel;
 pub mod domain;
 pub mod earth;
 pub mod filter;
+pub mod gnss;
 pub mod imu;
 pub mod lab;
 pub mod nav;

@@ -16,6 +16,7 @@ mod lines;
 mod lines_ahead;
 pub mod nav;
 pub mod nmea;
+pub mod rinex;
 pub mod rtklib;
 pub mod sensor_errors;
 pub mod vehicle;

@@ -1,0 +1,1 @@
+//! RINEX navigation files: broadcast ephemerides (to be written).
