@@ -11,7 +11,7 @@ pub mod obs;
 use crate::formats::InputError;
 use crate::formats::error::InputErrorKind;
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 /// The bytes that begin a gzip stream (RFC 1952).
@@ -41,7 +41,7 @@ pub(crate) fn open(path: &Path) -> Result<Box<dyn BufRead + Send>, InputError> {
 
 /// Everything `r` holds, for tests.
 #[cfg(test)]
-pub(crate) fn read_all(mut r: impl Read) -> String {
+pub(crate) fn read_all(mut r: impl std::io::Read) -> String {
     let mut s = String::new();
     r.read_to_string(&mut s).expect("read");
     s
