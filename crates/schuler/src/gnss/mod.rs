@@ -1,10 +1,28 @@
 //! Raw GNSS: satellites, their broadcast orbits and clocks, the signal's path through
 //! the atmosphere, and positions from pseudoranges.
 //!
-//! Times are GPS time (GPST) as a week number and seconds of week unless a module says
-//! otherwise; positions are ECEF (WGS84 for GPS, the systems' own realisations of ITRF
-//! otherwise, which agree at the centimetre level).
+//! Times are GPS time (GPST) as a week number and seconds of week ([`GpsTime`]) unless
+//! a module says otherwise; positions are ECEF (WGS84 for GPS, the systems' own
+//! realisations of ITRF otherwise, which agree at the centimetre level).
+//!
+//! A satellite's state for a pseudorange: read the navigation file into an
+//! [`EphemerisStore`], [`EphemerisStore::select`] the ephemeris for the satellite at
+//! the receive time, then [`Ephemeris::state_at_reception`] (transmission time, orbit,
+//! clock with the relativistic term, Earth rotation during the travel), and correct the
+//! clock for the band's [`Ephemeris::group_delay`].
 
+pub mod atmosphere;
+mod ephemeris;
+mod orbit;
 mod sat;
+mod store;
+pub mod time;
+mod transmit;
 
+pub use ephemeris::{
+    Band, C, DEFAULT_VALIDITY_S, Ephemeris, ICD_PI, Kepler, NavMessage, SystemConstants,
+};
+pub use orbit::{OrbitPoint, SatState, eccentric_anomaly};
 pub use sat::{Sat, System};
+pub use store::EphemerisStore;
+pub use time::GpsTime;

@@ -1,0 +1,167 @@
+//! The ephemerides of one or more navigation files, per satellite, and the choice of
+//! one for a satellite at an instant.
+//!
+//! The rule (as receivers and RTKLIB's `seleph` do): among the satellite's *healthy*
+//! ephemerides whose |t − toe| is within their validity ([`Ephemeris::validity_s`]:
+//! 2 h, or half a longer GPS fit interval), the one with the nearest toe; on a tie,
+//! the one stored last (a later upload of the same toe). An unhealthy ephemeris is never
+//! chosen, even when it is the only one: the satellite is then unavailable.
+
+use std::collections::BTreeMap;
+
+use super::ephemeris::{Ephemeris, NavMessage};
+use super::sat::Sat;
+use super::time::GpsTime;
+
+/// Broadcast ephemerides grouped by satellite, each group in the order stored.
+#[derive(Debug, Clone, Default)]
+pub struct EphemerisStore {
+    by_sat: BTreeMap<Sat, Vec<Ephemeris>>,
+}
+
+impl EphemerisStore {
+    /// An empty store.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds one ephemeris (an exact repeat of one already held is dropped).
+    pub fn push(&mut self, eph: Ephemeris) {
+        let list = self.by_sat.entry(eph.sat).or_default();
+        if !list.contains(&eph) {
+            list.push(eph);
+        }
+    }
+
+    /// The number of ephemerides held.
+    pub fn len(&self) -> usize {
+        self.by_sat.values().map(Vec::len).sum()
+    }
+
+    /// Whether the store holds none.
+    pub fn is_empty(&self) -> bool {
+        self.by_sat.is_empty()
+    }
+
+    /// The satellites with at least one ephemeris, in order.
+    pub fn sats(&self) -> impl Iterator<Item = Sat> + '_ {
+        self.by_sat.keys().copied()
+    }
+
+    /// Every ephemeris of `sat`, in the order stored.
+    pub fn of(&self, sat: Sat) -> &[Ephemeris] {
+        self.by_sat.get(&sat).map_or(&[], Vec::as_slice)
+    }
+
+    /// The ephemeris for `sat` at GPS instant `t` by the rule above, from any message.
+    pub fn select(&self, sat: Sat, t: GpsTime) -> Option<&Ephemeris> {
+        self.select_by(sat, t, |_| true)
+    }
+
+    /// As [`EphemerisStore::select`], from message `message` only (Galileo F/NAV for an
+    /// E1/E5a user, I/NAV for E1/E5b).
+    pub fn select_message(&self, sat: Sat, t: GpsTime, message: NavMessage) -> Option<&Ephemeris> {
+        self.select_by(sat, t, |e| e.message == message)
+    }
+
+    /// As [`EphemerisStore::select`], among the ephemerides `keep` accepts.
+    pub fn select_by(
+        &self,
+        sat: Sat,
+        t: GpsTime,
+        keep: impl Fn(&Ephemeris) -> bool,
+    ) -> Option<&Ephemeris> {
+        let mut best: Option<(&Ephemeris, f64)> = None;
+        for e in self.of(sat) {
+            let age = t.diff_s(e.toe).abs();
+            // A NaN age (a non-finite toe) is not within the validity either.
+            let within = age <= e.validity_s();
+            if !e.is_healthy() || !keep(e) || !within {
+                continue;
+            }
+            if best.is_none_or(|(_, b)| age <= b) {
+                best = Some((e, age));
+            }
+        }
+        best.map(|(e, _)| e)
+    }
+}
+
+impl Extend<Ephemeris> for EphemerisStore {
+    fn extend<I: IntoIterator<Item = Ephemeris>>(&mut self, iter: I) {
+        for e in iter {
+            self.push(e);
+        }
+    }
+}
+
+impl FromIterator<Ephemeris> for EphemerisStore {
+    fn from_iter<I: IntoIterator<Item = Ephemeris>>(iter: I) -> Self {
+        let mut s = Self::new();
+        s.extend(iter);
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gnss::ephemeris::tests::sample;
+    use crate::gnss::sat::System;
+
+    fn at(toe_h: f64, health: u32, iode: u32) -> Ephemeris {
+        let mut e = sample(System::Gps, 7, NavMessage::Lnav);
+        e.toe = GpsTime::new(1590, toe_h * 3600.0);
+        e.health = health;
+        e.iode = iode;
+        e
+    }
+
+    #[test]
+    fn nearest_healthy_toe_within_two_hours() {
+        let store: EphemerisStore = [at(0.0, 0, 1), at(2.0, 0, 2), at(4.0, 1, 3)]
+            .into_iter()
+            .collect();
+        let g07 = Sat::new(System::Gps, 7);
+        let pick = |h: f64| {
+            store
+                .select(g07, GpsTime::new(1590, h * 3600.0))
+                .map(|e| e.iode)
+        };
+        assert_eq!(pick(0.9), Some(1));
+        assert_eq!(pick(1.1), Some(2));
+        // The unhealthy toe 4 h is nearer, but never chosen.
+        assert_eq!(pick(3.9), Some(2));
+        assert_eq!(pick(4.1), None);
+        assert_eq!(pick(-2.5), None);
+        assert_eq!(
+            store.select(Sat::new(System::Gps, 8), GpsTime::new(1590, 0.0)),
+            None
+        );
+        // A tie goes to the one stored last.
+        assert_eq!(pick(1.0), Some(2));
+        assert_eq!(store.len(), 3);
+    }
+
+    #[test]
+    fn across_the_week_and_by_message() {
+        let mut store = EphemerisStore::new();
+        store.push(at(167.5, 0, 9)); // toe half an hour before the week's end
+        let t = GpsTime::new(1591, 0.25 * 3600.0);
+        assert_eq!(
+            store.select(Sat::new(System::Gps, 7), t).map(|e| e.iode),
+            Some(9)
+        );
+        let mut f = sample(System::Galileo, 3, NavMessage::Fnav);
+        f.iode = 5;
+        let mut i = f.clone();
+        i.message = NavMessage::Inav;
+        i.iode = 6;
+        store.extend([f, i]);
+        let e03 = Sat::new(System::Galileo, 3);
+        let t = GpsTime::new(1590, 345_600.0);
+        assert_eq!(store.select(e03, t).map(|e| e.iode), Some(6));
+        let fnav = store.select_message(e03, t, NavMessage::Fnav);
+        assert_eq!(fnav.map(|e| e.iode), Some(5));
+    }
+}
