@@ -5,6 +5,7 @@
 //! records are fixed-width. Both readers stream: they hold one epoch (or one
 //! ephemeris) at a time, and name the file, the line and the field of what they refuse.
 
+mod hatanaka;
 pub mod nav;
 pub mod obs;
 
