@@ -763,4 +763,42 @@ mod tests {
         let e = expand(&(crx_header("1.0") + &header)).unwrap_err();
         assert!(e.message.contains("does not hold"), "{e}");
     }
+
+    /// The compact files of tests/data/rinex_obs expand to their twins' text, line for
+    /// line after the header, but for trailing blanks (which the compact form drops)
+    /// and a leading zero the twin's writer left out of |x| < 1 (` .000000000000`:
+    /// the compact form keeps the integer, not how it was written).
+    #[test]
+    fn public_files_expand_to_their_uncompressed_text() {
+        use crate::formats::rinex::obs::ObsReader;
+        let dir =
+            std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/rinex_obs");
+        for (compact, plain) in [
+            ("AJAC3550.21d.gz", "AJAC3550.21o.gz"),
+            ("wsra0010.21d.gz", "wsra0010.21o.gz"),
+            (
+                "ACOR00ESP_R_20213550000_01D_30S_MO.crx.gz",
+                "ACOR00ESP_R_20213550000_01D_30S_MO.rnx.gz",
+            ),
+            ("VLNS0010.22d.gz", "VLNS0010.22o.gz"),
+        ] {
+            let path = dir.join(compact);
+            let mut reader = ObsReader::open(&path).unwrap();
+            let mut got = Vec::new();
+            while let Some((line, _)) = reader.source_for_test().next(&path).unwrap() {
+                got.push(String::from_utf8_lossy(line).into_owned());
+            }
+            let text = super::super::read_all(super::super::open(&dir.join(plain)).unwrap());
+            let want: Vec<String> = text
+                .lines()
+                .skip_while(|l| !l.contains("END OF HEADER"))
+                .skip(1)
+                .map(|l| l.trim_end().replace(" .", "0."))
+                .collect();
+            assert_eq!(got.len(), want.len(), "{compact}");
+            for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                assert_eq!(g, w, "{compact}: data line {}", i + 1);
+            }
+        }
+    }
 }
