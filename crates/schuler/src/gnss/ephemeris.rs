@@ -189,10 +189,21 @@ pub struct Ephemeris {
     pub fit_interval_s: f64,
 }
 
-/// The largest |t − toe| [s] for which an ephemeris is used when its message gives no
-/// longer fit interval: 2 h, half of GPS's 4-hour fit interval (IS-GPS-200 §20.3.4.4),
-/// applied to every system (Galileo and BeiDou refresh theirs every 10 min and 1 h).
+/// The largest |t − toe| [s] for which a GPS or QZSS ephemeris is used when its
+/// message gives no longer fit interval: 2 h, half of GPS's 4-hour fit interval
+/// (IS-GPS-200 §20.3.4.4), whose toe is the middle of the interval.
 pub const DEFAULT_VALIDITY_S: f64 = 7_200.0;
+
+/// How long after its toe [s] a Galileo ephemeris is used: 4 h, the validity of a
+/// Galileo navigation data set (OS SIS ICD §5.1.9.2 "age of data"; also RTKLIB's
+/// bound). Galileo fits each set for the time after its toe: extrapolated backwards an
+/// hour it errs by metres, so it is used at most [`EARLY_S`] before toe.
+pub const GALILEO_VALIDITY_S: f64 = 14_400.0;
+
+/// How long before its toe [s] a Galileo or BeiDou ephemeris may be used: 10 min,
+/// Galileo's refresh interval (BeiDou's toe falls on the hour, a few seconds after a
+/// GPS-time epoch on the hour since BDT lags GPST by 14 s).
+pub const EARLY_S: f64 = 600.0;
 
 impl Ephemeris {
     /// The system's constants (GPS's for a system without its own, which cannot occur
@@ -220,10 +231,26 @@ impl Ephemeris {
         }
     }
 
-    /// The largest |t − toe| [s] this ephemeris is used for: half its fit interval if
-    /// that exceeds [`DEFAULT_VALIDITY_S`], else that.
-    pub fn validity_s(&self) -> f64 {
-        (0.5 * self.fit_interval_s).max(DEFAULT_VALIDITY_S)
+    /// The interval of `t − toe` [s] over which this ephemeris is used: GPS and QZSS
+    /// ±half the fit interval, at least ±[`DEFAULT_VALIDITY_S`] (toe mid-interval);
+    /// Galileo from −[`EARLY_S`] to [`GALILEO_VALIDITY_S`], BeiDou from −[`EARLY_S`]
+    /// to [`DEFAULT_VALIDITY_S`] (toe at the start of their use, refreshed every 10 min
+    /// and every hour).
+    pub fn fit_window_s(&self) -> (f64, f64) {
+        match self.sat.system {
+            System::Galileo => (-EARLY_S, GALILEO_VALIDITY_S),
+            System::BeiDou => (-EARLY_S, DEFAULT_VALIDITY_S),
+            _ => {
+                let v = (0.5 * self.fit_interval_s).max(DEFAULT_VALIDITY_S);
+                (-v, v)
+            }
+        }
+    }
+
+    /// Whether the ephemeris is chosen by the nearest toe (GPS, QZSS: toe in the middle
+    /// of the fit) rather than the latest toe (Galileo, BeiDou: toe at its start).
+    pub fn toe_is_mid_fit(&self) -> bool {
+        !matches!(self.sat.system, System::Galileo | System::BeiDou)
     }
 
     /// The group delay [s] a single-frequency user of `band` subtracts from the

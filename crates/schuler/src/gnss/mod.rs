@@ -20,7 +20,8 @@ pub mod time;
 mod transmit;
 
 pub use ephemeris::{
-    Band, C, DEFAULT_VALIDITY_S, Ephemeris, ICD_PI, Kepler, NavMessage, SystemConstants,
+    Band, C, DEFAULT_VALIDITY_S, EARLY_S, Ephemeris, GALILEO_VALIDITY_S, ICD_PI, Kepler,
+    NavMessage, SystemConstants,
 };
 pub use orbit::{OrbitPoint, SatState, eccentric_anomaly};
 pub use sat::{Sat, System};

@@ -1,11 +1,14 @@
 //! The ephemerides of one or more navigation files, per satellite, and the choice of
 //! one for a satellite at an instant.
 //!
-//! The rule (as receivers and RTKLIB's `seleph` do): among the satellite's *healthy*
-//! ephemerides whose |t − toe| is within their validity ([`Ephemeris::validity_s`]:
-//! 2 h, or half a longer GPS fit interval), the one with the nearest toe; on a tie,
-//! the one stored last (a later upload of the same toe). An unhealthy ephemeris is never
-//! chosen, even when it is the only one: the satellite is then unavailable.
+//! The rule: among the satellite's *healthy* ephemerides whose `t − toe` lies in their
+//! window ([`Ephemeris::fit_window_s`]), for GPS and QZSS the one with the nearest toe
+//! (their toe is the middle of a 4-hour fit: within ±2 h, or half a longer fit
+//! interval); for Galileo and BeiDou the latest toe (each set is fitted for the time
+//! after its toe: from 10 min before it to 4 h after for Galileo, 2 h for BeiDou).
+//! On a tie, the one stored last (a later upload of the same toe). An unhealthy
+//! ephemeris is never chosen, even when it is the only one: the satellite is then
+//! unavailable.
 
 use std::collections::BTreeMap;
 
@@ -73,14 +76,17 @@ impl EphemerisStore {
     ) -> Option<&Ephemeris> {
         let mut best: Option<(&Ephemeris, f64)> = None;
         for e in self.of(sat) {
-            let age = t.diff_s(e.toe).abs();
-            // A NaN age (a non-finite toe) is not within the validity either.
-            let within = age <= e.validity_s();
+            let age = t.diff_s(e.toe);
+            let (early, late) = e.fit_window_s();
+            // A NaN age (a non-finite toe) is not within the window either.
+            let within = age >= early && age <= late;
             if !e.is_healthy() || !keep(e) || !within {
                 continue;
             }
-            if best.is_none_or(|(_, b)| age <= b) {
-                best = Some((e, age));
+            // Nearest toe, or latest toe (the smallest signed age).
+            let score = if e.toe_is_mid_fit() { age.abs() } else { age };
+            if best.is_none_or(|(_, b)| score <= b) {
+                best = Some((e, score));
             }
         }
         best.map(|(e, _)| e)
@@ -153,6 +159,7 @@ mod tests {
             Some(9)
         );
         let mut f = sample(System::Galileo, 3, NavMessage::Fnav);
+        f.toe = GpsTime::new(1590, 345_000.0);
         f.iode = 5;
         let mut i = f.clone();
         i.message = NavMessage::Inav;
@@ -163,5 +170,42 @@ mod tests {
         assert_eq!(store.select(e03, t).map(|e| e.iode), Some(6));
         let fnav = store.select_message(e03, t, NavMessage::Fnav);
         assert_eq!(fnav.map(|e| e.iode), Some(5));
+    }
+
+    #[test]
+    fn galileo_and_beidou_take_the_latest_toe() {
+        let mut store = EphemerisStore::new();
+        for (sys, prn) in [(System::Galileo, 5), (System::BeiDou, 30)] {
+            for (iode, toe_h) in [(1, 0.0), (2, 1.0), (3, 5.0)] {
+                let mut e = sample(sys, prn, NavMessage::Inav);
+                e.message = if sys == System::BeiDou {
+                    NavMessage::D1
+                } else {
+                    NavMessage::Inav
+                };
+                e.toe = GpsTime::new(1590, toe_h * 3600.0);
+                e.iode = iode;
+                store.push(e);
+            }
+            let sat = Sat::new(sys, prn);
+            let pick = |h: f64| {
+                store
+                    .select(sat, GpsTime::new(1590, h * 3600.0))
+                    .map(|e| e.iode)
+            };
+            // At 0.8 h toe 1 h is nearer but 12 min ahead, not yet in force; at 0.9 h it is.
+            assert_eq!(pick(0.8), Some(1));
+            assert_eq!(pick(0.9), Some(2));
+            assert_eq!(pick(1.6), Some(2));
+            // Galileo keeps a set 4 h, BeiDou 2 h.
+            let late = if sys == System::Galileo {
+                Some(2)
+            } else {
+                None
+            };
+            assert_eq!(pick(4.5), late);
+            assert_eq!(pick(5.0), Some(3));
+            assert_eq!(pick(-0.5), None);
+        }
     }
 }
