@@ -19,6 +19,7 @@ pub mod nmea;
 pub mod rinex;
 pub mod rtklib;
 pub mod sensor_errors;
+pub mod sp3;
 pub mod vehicle;
 
 pub use error::InputError;
