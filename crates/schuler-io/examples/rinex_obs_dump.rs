@@ -6,6 +6,10 @@
 //!
 //! `cargo run -p schuler-io --example rinex_obs_dump -- FILE`; the observations of
 //! `crates/schuler-io/tests/georinex_check.py` to compare with georinex's.
+//!
+//! `--time FILE…` instead reads each file into memory and times the reader on it (the
+//! best of five passes; a gzip file is gunzipped first): bytes, epochs, observations,
+//! MB/s.
 
 use schuler_io::formats::rinex::obs::{Epoch, ObsReader};
 use std::io::Write;
@@ -13,11 +17,18 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let Some(path) = std::env::args_os().nth(1).map(PathBuf::from) else {
-        eprintln!("usage: rinex_obs_dump FILE");
-        return ExitCode::from(2);
+    let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
+    let result = match args.as_slice() {
+        [path] => dump(path),
+        [flag, paths @ ..] if flag.as_os_str() == "--time" => {
+            paths.iter().try_for_each(|p| time(p))
+        }
+        _ => {
+            eprintln!("usage: rinex_obs_dump FILE | rinex_obs_dump --time FILE...");
+            return ExitCode::from(2);
+        }
     };
-    match dump(&path) {
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("{e}");
@@ -53,5 +64,38 @@ fn dump(path: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     out.flush()?;
+    Ok(())
+}
+
+/// Times the reader on `path`'s bytes in memory (gunzipped first when gzip).
+fn time(path: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    let mut bytes = std::fs::read(path)?;
+    if bytes.starts_with(&[0x1f, 0x8b]) {
+        let mut plain = Vec::new();
+        std::io::Read::read_to_end(
+            &mut flate2::read::MultiGzDecoder::new(&bytes[..]),
+            &mut plain,
+        )?;
+        bytes = plain;
+    }
+    let mut best = f64::INFINITY;
+    let (mut epochs, mut obs) = (0, 0);
+    for _ in 0..5 {
+        let t0 = std::time::Instant::now();
+        let mut reader = ObsReader::new(&bytes[..], path)?;
+        let mut epoch = Epoch::default();
+        (epochs, obs) = (0, 0);
+        while reader.read_epoch(&mut epoch)? {
+            epochs += 1;
+            obs += epoch.sats().map(|s| s.obs.len()).sum::<usize>();
+        }
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    println!(
+        "{}: {} bytes, {epochs} epochs, {obs} observations, best of 5 {best:.3} s, {:.1} MB/s",
+        path.display(),
+        bytes.len(),
+        bytes.len() as f64 / best / 1e6
+    );
     Ok(())
 }
