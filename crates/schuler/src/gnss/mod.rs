@@ -10,20 +10,30 @@
 //! the receive time, then [`Ephemeris::state_at_reception`] (transmission time, orbit,
 //! clock with the relativistic term, Earth rotation during the travel), and correct the
 //! clock for the band's [`Ephemeris::group_delay`].
+//!
+//! A position from raw measurements: convert a source's epoch into a [`RawEpoch`]
+//! ([`raw`]), then [`spp::solve`] it (single-point position, clocks, Doppler velocity,
+//! fault detection and exclusion).
 
 pub mod atmosphere;
+mod dop;
 mod ephemeris;
 mod orbit;
+pub mod raw;
 mod sat;
+pub mod spp;
 mod store;
 pub mod time;
 mod transmit;
 
+pub use dop::Dop;
 pub use ephemeris::{
     Band, C, DEFAULT_VALIDITY_S, EARLY_S, Ephemeris, GALILEO_VALIDITY_S, ICD_PI, Kepler,
     NavMessage, SystemConstants,
 };
 pub use orbit::{OrbitPoint, SatState, eccentric_anomaly};
+pub use raw::{PhaseLock, RawEpoch, RawMeasurement, Signal};
 pub use sat::{Sat, System};
+pub use spp::{SppConfig, SppError, SppSolution};
 pub use store::EphemerisStore;
 pub use time::GpsTime;
