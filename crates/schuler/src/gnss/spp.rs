@@ -594,7 +594,14 @@ fn candidates<'a>(
             freq,
             clock,
             active: true,
-            state: eph.state_at(epoch.t),
+            // Computed by the least squares before its first use.
+            state: SatState {
+                t: epoch.t,
+                r_e: Vector3::zeros(),
+                v_e: Vector3::zeros(),
+                clock_bias: 0.0,
+                clock_drift: 0.0,
+            },
         });
     }
     // `epoch.sats()` is sorted, so the systems come in `System`'s order.
@@ -649,6 +656,32 @@ fn largest_w(fix: &Fix) -> Option<(usize, f64)> {
         }
     }
     best
+}
+
+/// Adds one row `h = [−u, 1 at the clock]` of weight `1/var` and residual `v` to the
+/// normal equations: `N += hᵀh/var`, `b += hᵀv/var` (h's five non-zeros only; a
+/// general 10×10 outer product was a sixth of the solver's time).
+fn accumulate(
+    normal: &mut Normal,
+    b: &mut SVector<f64, MAX_UNKNOWNS>,
+    u: &Vector3<f64>,
+    clock: usize,
+    v: f64,
+    var: f64,
+) {
+    let w = 1.0 / var;
+    let k = 3 + clock;
+    for i in 0..3 {
+        let hi = -u[i] * w;
+        for j in 0..3 {
+            normal[(i, j)] += hi * -u[j];
+        }
+        normal[(i, k)] += hi;
+        normal[(k, i)] += hi;
+        b[i] += hi * v;
+    }
+    normal[(k, k)] += w;
+    b[k] += w * v;
 }
 
 /// The design vector `[−u, 1 at the clock]`.
@@ -800,9 +833,7 @@ impl Linearisation<'_> {
                 range + x[3 + c.clock] - C * (c.state.clock_bias - c.tgd) + iono_m + tropo_m;
             let residual = c.pseudorange - modelled;
             let var = self.variance(c, look.elevation, iono_m);
-            let h = design_row(&u, c.clock);
-            normal += (h / var) * h.transpose();
-            b += h * (residual / var);
+            accumulate(&mut normal, &mut b, &u, c.clock, residual, var);
             clock_used[c.clock] = true;
             rows.push(Row {
                 cand: i,
