@@ -334,7 +334,8 @@ pub struct UsedSat {
     pub rate_residual: Option<f64>,
 }
 
-/// The chi-square test of the final solution's residuals.
+/// The chi-square test of the final solution's residuals (at the FDE's false-alarm
+/// probability; at 1e-3 when FDE is off).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ResidualTest {
     /// `vᵀWv`.
