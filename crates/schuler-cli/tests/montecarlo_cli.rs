@@ -75,8 +75,9 @@ fn mean_nees_of_twenty_runs_lies_in_its_chi_square_interval() {
         assert!(b.contains(m), "{block}: mean NEES {m}");
     }
     let mut wrong = config();
-    wrong.nav_flags.retain(|f| !f.starts_with("--imu-grade"));
-    wrong.nav_flags.push("--imu-grade=navigation".into());
+    wrong
+        .nav_options
+        .insert("imu_grade".into(), "navigation".into());
     let a = Aggregate::of(&campaign::run(&wrong, 5, 1, None).expect("runs"));
     let n = a.nees.as_ref().expect("NEES");
     println!("told a navigation-grade IMU: mean NEES {:?}", n.grand_mean);

@@ -7,7 +7,6 @@
 
 use crate::columns::{CONVERGENCE, Columns};
 use crate::errors::IntoPy;
-use clap::Parser;
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -17,28 +16,21 @@ use schuler_run::alignment::{AlignArgs, setup};
 use schuler_run::alignment::{align_on, convergence_row, read_stage, summary_text, to_json};
 use schuler_run::nav::Began;
 
-/// `schuler align`'s arguments.
-#[derive(Parser, Debug)]
-#[command(name = "align", no_binary_name = true)]
-struct AlignFlags {
-    #[command(flatten)]
-    args: AlignArgs,
-}
-
-/// Aligns as `schuler align` with `flags` (`--imu` names the file, or a placeholder
+/// Aligns as `schuler align` with `options` (its flags' names with underscores; `imu`
+/// names the file, or a placeholder
 /// when `imu` columns `t, dtheta_xyz, dvel_xyz` are given, `dt` optional): a dict of
 /// `summary` (`align.json` as JSON text), `convergence` (columns of
 /// `align_convergence.csv`) and `report` (the printed text without run times). The
 /// GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (flags, imu=None, imu_dt=None))]
+#[pyo3(signature = (options, imu=None, imu_dt=None))]
 pub fn align<'py>(
     py: Python<'py>,
-    flags: Vec<String>,
+    options: Bound<'py, PyDict>,
     imu: Option<Vec<PyReadonlyArray1<'py, f64>>>,
     imu_dt: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let args = AlignFlags::try_parse_from(&flags).py_err(py)?.args;
+    let args = AlignArgs::from_options(crate::options::table(&options)?).py_err(py)?;
     let views = match &imu {
         Some(cols) => Some(crate::imu_views(cols, imu_dt.as_ref(), None).py_err(py)?),
         None => None,

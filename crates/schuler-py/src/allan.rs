@@ -25,15 +25,15 @@ const ALLAN: &[&str] = &[
 ];
 
 /// The Allan deviations of the IMU file `path` (read as `schuler allan` reads it, with
-/// the IMU input `flags`) or of the columns `imu` (`t, dtheta_xyz, dvel_xyz`, `dt`
+/// the IMU input `options`) or of the columns `imu` (`t, dtheta_xyz, dvel_xyz`, `dt`
 /// optional): `per_decade` cluster sizes a decade up to `max_tau` [s] (default a
 /// tenth of the log). The GIL is released.
 #[pyfunction]
-#[pyo3(signature = (path=None, flags=Vec::new(), imu=None, imu_dt=None, per_decade=10.0, max_tau=None))]
+#[pyo3(signature = (path=None, options=None, imu=None, imu_dt=None, per_decade=10.0, max_tau=None))]
 pub fn allan<'py>(
     py: Python<'py>,
     path: Option<PathBuf>,
-    flags: Vec<String>,
+    options: Option<Bound<'py, PyDict>>,
     imu: Option<Vec<PyReadonlyArray1<'py, f64>>>,
     imu_dt: Option<PyReadonlyArray1<'py, f64>>,
     per_decade: f64,
@@ -43,7 +43,11 @@ pub fn allan<'py>(
         Some(cols) => Some(crate::imu_views(cols, imu_dt.as_ref(), None).py_err(py)?),
         None => None,
     };
-    let opts = crate::options::imu_options(&flags).py_err(py)?;
+    let options = match &options {
+        Some(o) => crate::options::table(o)?,
+        None => toml::Table::new(),
+    };
+    let opts = crate::options::imu_options(options).py_err(py)?;
     let a = py
         .detach(|| -> anyhow::Result<ImuAllan> {
             let samples: Vec<ImuSample> = match (&views, &path) {

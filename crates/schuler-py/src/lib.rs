@@ -82,17 +82,17 @@ pub(crate) fn given_readings(
     })
 }
 
-/// Navigates as `schuler nav` with `flags`: the IMU samples from `imu` (columns) or the
-/// file of `--imu`, aids from `gnss`/`baro`/`rest`/`odometer`/`heading` columns or
+/// Navigates as `schuler nav` with `options` (its flags' names with underscores): the
+/// IMU samples from `imu` (columns) or the file of the `imu` option, aids from `gnss`/`baro`/`rest`/`odometer`/`heading` columns or
 /// their files. Returns the tables (see [`Tables::take_dict`]), `smoothed` (with
 /// `--smooth`), `summary` and how the run started (`alignment` with `--align`,
 /// `start_in_motion` with `--init gnss`). The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (flags, imu=None, imu_dt=None, gnss=None, baro=None, rest=None, odometer=None, heading=None))]
+#[pyo3(signature = (options, imu=None, imu_dt=None, gnss=None, baro=None, rest=None, odometer=None, heading=None))]
 #[allow(clippy::too_many_arguments)] // one keyword argument per input, as Python passes them
 fn navigate<'py>(
     py: Python<'py>,
-    flags: Vec<String>,
+    options: Bound<'py, PyDict>,
     imu: Option<Vec<PyReadonlyArray1<'py, f64>>>,
     imu_dt: Option<PyReadonlyArray1<'py, f64>>,
     gnss: Option<Vec<PyReadonlyArray1<'py, f64>>>,
@@ -101,8 +101,9 @@ fn navigate<'py>(
     odometer: ColumnsIn<'py>,
     heading: ColumnsIn<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let options = options::table(&options)?;
     let mut plan = given_readings(gnss, baro, [&rest, &odometer, &heading])
-        .and_then(|given| Plan::new(&flags, given))
+        .and_then(|given| Plan::new(options, given))
         .py_err(py)?;
     let views = match &imu {
         Some(cols) => Some(imu_views(cols, imu_dt.as_ref(), None).py_err(py)?),

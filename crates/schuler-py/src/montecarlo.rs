@@ -19,8 +19,8 @@ pub struct Source<'a> {
     base: Option<&'a Path>,
 }
 
-/// The campaign of `src`, with `flags` after its `[navigate]` flags (so they win).
-fn config(src: &Source<'_>, flags: &[String]) -> anyhow::Result<CampaignConfig> {
+/// The campaign of `src`, with `options` over its `[navigate]` options (they win).
+fn config(src: &Source<'_>, options: toml::Table) -> anyhow::Result<CampaignConfig> {
     let base = src.base.unwrap_or(Path::new(""));
     let c = match (src.path, src.text) {
         (Some(p), _) => CampaignConfig::load(p)?,
@@ -32,16 +32,19 @@ fn config(src: &Source<'_>, flags: &[String]) -> anyhow::Result<CampaignConfig> 
         (None, Some(t)) => CampaignConfig::from_toml(t, base, "the campaign (TOML text)")?,
         (None, None) => anyhow::bail!("no campaign: give a file or its text"),
     };
-    Ok(c.with_flags(flags))
+    let c = c.with_options(options);
+    // A misspelt keyword is refused before any run.
+    schuler_run::nav::NavConfig::from_options(c.nav_options.clone())?;
+    Ok(c)
 }
 
 /// Runs the campaign of `path` (or `text` in `format` "toml" or "json", relative
-/// paths from `base`) with `flags`
-/// added to its `[navigate]` options, for the scenario seeds `seeds`, on `threads`
+/// paths from `base`) with `options` (nav's, by name)
+/// over its `[navigate]` options, for the scenario seeds `seeds`, on `threads`
 /// threads (None: one per core): a dict of the table's columns (`seed`, then
 /// `runs.csv`'s), in the order of `seeds`. The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (seeds, path=None, text=None, format="toml", base=None, flags=Vec::new(), threads=None))]
+#[pyo3(signature = (seeds, path=None, text=None, format="toml", base=None, options=None, threads=None))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments
 pub fn montecarlo_seeds<'py>(
     py: Python<'py>,
@@ -50,7 +53,7 @@ pub fn montecarlo_seeds<'py>(
     text: Option<String>,
     format: &str,
     base: Option<PathBuf>,
-    flags: Vec<String>,
+    options: Option<Bound<'py, PyDict>>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if threads == Some(0) {
@@ -64,7 +67,11 @@ pub fn montecarlo_seeds<'py>(
         format,
         base: base.as_deref(),
     };
-    let c = config(&src, &flags).py_err(py)?;
+    let options = match &options {
+        Some(o) => crate::options::table(o)?,
+        None => toml::Table::new(),
+    };
+    let c = config(&src, options).py_err(py)?;
     let results = py
         .detach(|| campaign::run_seeds(&c, &seeds, threads))
         .py_err(py)?;

@@ -9,15 +9,15 @@ use pyo3::types::PyDict;
 use schuler_io::formats::ImuReader;
 use std::path::PathBuf;
 
-/// IMU samples of `path` as the CLI reads them with `flags` (the IMU input flags,
-/// `--start`, `--end`): columns `t_s`, `dt_s`, `dtheta_*_rad`, `dvel_*_mps` (FRD).
+/// IMU samples of `path` as the CLI reads them with `options` (the IMU input options,
+/// `start`, `end`): columns `t_s`, `dt_s`, `dtheta_*_rad`, `dvel_*_mps` (FRD).
 #[pyfunction]
 pub fn read_imu<'py>(
     py: Python<'py>,
     path: PathBuf,
-    flags: Vec<String>,
+    options: Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let opts = crate::options::imu_options(&flags).py_err(py)?;
+    let opts = crate::options::imu_options(crate::options::table(&options)?).py_err(py)?;
     let mut c = py
         .detach(|| -> anyhow::Result<Columns> {
             let mut c = Columns::new(IMU);
@@ -32,15 +32,15 @@ pub fn read_imu<'py>(
     c.take_dict(py)
 }
 
-/// GNSS fixes of `path` as `schuler nav --gnss` reads them with `flags` (format,
+/// GNSS fixes of `path` as `schuler nav --gnss` reads them with `options` (format,
 /// default std, quality, time offset, velocity log): columns of [`GNSS`].
 #[pyfunction]
 pub fn read_gnss<'py>(
     py: Python<'py>,
     path: PathBuf,
-    flags: Vec<String>,
+    options: Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut opts = crate::options::aiding_options(&flags).py_err(py)?;
+    let mut opts = crate::options::aiding_options(crate::options::table(&options)?).py_err(py)?;
     opts.gnss = Some(path);
     let fixes = py.detach(|| opts.fixes(None)).py_err(py)?;
     let mut c = Columns::new(GNSS);

@@ -22,12 +22,12 @@ use schuler_run::aided::{Aiding, GivenReadings};
 use schuler_run::alignment::AlignOptions;
 use schuler_run::drive::{Refusal, imu_err_row, std_row};
 use schuler_run::nav::{
-    BANK_MEMBERS, BANK_SECONDS, Began, InitChoice, begin, parse_nav_args, resolve_aiding,
+    BANK_MEMBERS, BANK_SECONDS, Began, InitChoice, begin, plan_of, resolve_aiding,
 };
 use schuler_run::navigate::{NavSettings, decide_heading, open_session};
 use schuler_run::options::EarthChoice;
 
-/// The settings and aiding of a run, from the CLI's flags.
+/// The settings and aiding of a run, from its keyword arguments.
 pub struct Plan {
     /// Settings (the IMU path among them, unused for arrays).
     pub settings: NavSettings,
@@ -40,9 +40,9 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The plan of `flags` with `given` readings in place of `--gnss`/`--baro` files.
-    pub fn new(flags: &[String], given: GivenReadings) -> Result<Self> {
-        let plan = parse_nav_args(crate::options::nav_args(flags)?)?;
+    /// The plan of `options` with `given` readings in place of `gnss`/`baro` files.
+    pub fn new(options: toml::Table, given: GivenReadings) -> Result<Self> {
+        let plan = plan_of(crate::options::nav_description(options)?)?;
         let aiding = resolve_aiding(&plan.alignment, &plan.aiding, given)?;
         Ok(Self {
             settings: plan.settings,

@@ -53,15 +53,15 @@ impl PySession {
 
 #[pymethods]
 impl PySession {
-    /// A session configured by `schuler nav`'s `flags` (an `--imu` placeholder among
+    /// A session configured by `schuler nav`'s `options` (an `imu` placeholder among
     /// them; aids are pushed, not read); `gnss`, `baro`, `rest`, `odometer`, `heading`:
     /// such aids will be pushed (the filter is set up for them as for their files:
     /// barometer bias, rest updates, odometer noise and scale factor, antenna baseline).
     #[new]
-    #[pyo3(signature = (flags, gnss=false, baro=false, rest=false, odometer=false, heading=false))]
+    #[pyo3(signature = (options, gnss=false, baro=false, rest=false, odometer=false, heading=false))]
     fn new(
         py: Python<'_>,
-        flags: Vec<String>,
+        options: Bound<'_, PyDict>,
         gnss: bool,
         baro: bool,
         rest: bool,
@@ -77,7 +77,7 @@ impl PySession {
                 headings: heading.then(Vec::new),
             },
         };
-        let plan = Plan::new(&flags, given).py_err(py)?;
+        let plan = Plan::new(crate::options::table(&options)?, given).py_err(py)?;
         if plan.align.is_some() || plan.init != InitChoice::Given {
             return Err(SchulerError::new_err(
                 "a Session starts from the given state (init_pos, init_vel, init_att): \

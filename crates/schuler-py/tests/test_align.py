@@ -75,9 +75,9 @@ def test_align_reaches_the_true_attitude(at_rest):
 
 
 def test_align_options_are_the_cli_checks(at_rest):
-    with pytest.raises(schuler.SchulerError, match="--block"):
+    with pytest.raises(schuler.SchulerError, match="block"):
         schuler.align(at_rest / "imu.txt", pos=BASE, coarse="10 s", block="20 s")
-    with pytest.raises(TypeError, match="unexpected argument"):
+    with pytest.raises(TypeError, match="^unknown option `no_such_option`$"):
         schuler.align(at_rest / "imu.txt", pos=BASE, no_such_option=1)
 
 

@@ -79,5 +79,5 @@ def test_bad_values_are_refused():
         schuler.closed_form([0.0], radius=-1.0)
     with pytest.raises(schuler.SchulerError, match=r"t\[1\]"):
         schuler.closed_form([0.0, np.nan])
-    with pytest.raises(schuler.SchulerError, match="--accel-bias-p1 applies to --system sins"):
+    with pytest.raises(schuler.SchulerError, match="accel_bias_p1 applies to system sins"):
         schuler.channel(accel_bias_p1="1e-3m/s^2")

@@ -181,5 +181,5 @@ def test_bad_vehicle_values_name_the_field(drive, logs):
     s.push_odometer(1.0, 2.0)
     assert list(s.take().refused["reason"]) == ["no odometer in the configuration"]
     # An option of an aid the session was not set up for is the CLI's error.
-    with pytest.raises(schuler.SchulerError, match="--odometer-std needs --odometer"):
+    with pytest.raises(schuler.SchulerError, match="odometer_std needs odometer"):
         schuler.Session(gnss=True, odometer_std="0.05 m/s", **START)

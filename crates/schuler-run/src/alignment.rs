@@ -23,13 +23,16 @@ use std::path::{Path, PathBuf};
 pub struct AlignOptions {
     /// Coarse stage length (e.g. `190s`, `3 min`; default 190 s).
     #[arg(long, value_name = "TIME", allow_hyphen_values = true)]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub coarse: Option<String>,
     /// Fine stage length (default 670 s; `0` for coarse only).
     #[arg(long, value_name = "TIME", allow_hyphen_values = true)]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub fine: Option<String>,
     /// Averaging block: spike test window, motion detector block and fine-filter
     /// measurement window (default 1 s; the averaging filter's band is 1/block).
     #[arg(long, value_name = "TIME", allow_hyphen_values = true)]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub block: Option<String>,
     /// Noise model the filters assume (default: navigation for alignment, tactical
     /// with --gnss).
@@ -38,6 +41,7 @@ pub struct AlignOptions {
     /// External heading instead of gyrocompassing: `DEG` or `DEG,STD_DEG` (default std
     /// 1 deg).
     #[arg(long, value_name = "DEG[,STD]", allow_hyphen_values = true)]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub heading: Option<String>,
     /// Refuse gyrocompassing when the predicted heading std exceeds this (default
     /// 1 deg).
@@ -431,6 +435,46 @@ pub struct AlignArgs {
     pub input: ImuInputOptions,
 }
 
+/// `schuler align`'s own options beside its two groups, as data (each optional here,
+/// so that each is read alone; the required ones are checked after).
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AlignOwn {
+    imu: Option<PathBuf>,
+    pos: Option<Triple>,
+    start: Option<f64>,
+    out: Option<PathBuf>,
+    #[serde(default)]
+    earth: EarthChoice,
+}
+
+impl AlignArgs {
+    /// The arguments described by flat options, each the name of a flag with
+    /// underscores (Python's keyword arguments; see [`crate::flat_options`]).
+    pub fn from_options(options: toml::Table) -> Result<Self> {
+        use crate::flat_options::{keys_of, partition, read_group, unknown_option};
+        let (align_keys, input_keys) = (keys_of::<AlignOptions>(), ImuInputOptions::keys());
+        let (groups, own) = partition(options, &[&align_keys, &input_keys]);
+        let known = keys_of::<AlignArgs>();
+        if let Some(k) = own.keys().find(|k| !known.contains(k)) {
+            return Err(unknown_option(k, &known));
+        }
+        let [options, input] = <[toml::Table; 2]>::try_from(groups)
+            .map_err(|_| anyhow::anyhow!("two option groups"))?;
+        let own: AlignOwn = read_group(own)?;
+        let required = |name: &str| anyhow::anyhow!("option `{name}` is required");
+        Ok(Self {
+            imu: own.imu.ok_or_else(|| required("imu"))?,
+            pos: own.pos.ok_or_else(|| required("pos"))?,
+            options: read_group(options)?,
+            start: own.start,
+            out: own.out,
+            earth: own.earth,
+            input: read_group(input)?,
+        })
+    }
+}
+
 /// The checked configuration, noise model and base position of `args`.
 pub fn setup(args: &AlignArgs) -> Result<(AlignConfig, ImuNoise, Geodetic)> {
     let (cfg, noise) = args.options.resolve()?;
@@ -439,4 +483,43 @@ pub fn setup(args: &AlignArgs) -> Result<(AlignConfig, ImuNoise, Geodetic)> {
         bail!("--pos: latitude {lat} deg is outside [-90, 90]");
     }
     Ok((cfg, noise, Geodetic::from_degrees(lat, lon, h)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    #[command(no_binary_name = true)]
+    struct Flags {
+        #[command(flatten)]
+        args: AlignArgs,
+    }
+
+    #[test]
+    fn options_by_name_give_the_arguments_of_their_flags() {
+        let flags = [
+            "--imu=a.txt",
+            "--pos=45,7,200",
+            "--coarse=60 s",
+            "--imu-grade=navigation",
+            "--gyro-unit=deg/s",
+        ];
+        let a = Flags::try_parse_from(flags).expect("flags").args;
+        let options = "imu = 'a.txt'\npos = [45, 7, 200]\ncoarse = '60 s'\nimu_grade = 'navigation'\ngyro_unit = 'deg/s'";
+        let b = AlignArgs::from_options(options.parse().expect("toml")).expect("options");
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        let e = AlignArgs::from_options("imu = 'a.txt'".parse().expect("toml")).unwrap_err();
+        assert_eq!(e.to_string(), "option `pos` is required");
+        let e = AlignArgs::from_options(
+            "imu = 'a'\npos = [0, 0, 0]\nblocks = '1 s'"
+                .parse()
+                .expect("toml"),
+        );
+        assert_eq!(
+            e.unwrap_err().to_string(),
+            "unknown option `blocks` (did you mean `block`?)"
+        );
+    }
 }

@@ -18,6 +18,7 @@ pub mod channel;
 pub mod compare;
 pub mod demo;
 pub mod drive;
+pub mod flat_options;
 pub mod imu_input;
 pub mod interrupt;
 pub mod kf_gins;

@@ -104,6 +104,28 @@ def _value(v: Any) -> str:
     raise TypeError(f"cannot pass {type(v).__name__} as an option value")
 
 
+def _plain(name: str, v: Any) -> Any:
+    """A keyword option's value as the plain data the run's description takes: bool,
+    int, float, str (paths as text) or a list of them."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v)
+    if isinstance(v, (str, os.PathLike)):
+        return os.fspath(v)
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return [_plain(name, x) for x in v]
+    raise TypeError(f"option `{name}`: cannot pass a {type(v).__name__} as an option value")
+
+
+def _options(options: Mapping[str, Any]) -> Dict[str, Any]:
+    """Keyword options as a run's description (None left out): the names are ``schuler
+    nav``'s flags with underscores, read and checked by the application layer."""
+    return {name: _plain(name, v) for name, v in options.items() if v is not None}
+
+
 def _flags(options: Mapping[str, Any]) -> List[str]:
     """``schuler nav``'s flags of keyword options (None and False are left out)."""
     out = []
@@ -178,11 +200,11 @@ def _heading(heading: Table) -> List[np.ndarray]:
     return _columns(heading, names, "heading")
 
 
-#: The vehicle aids: keyword, the flag of its file, and its columns.
+#: The vehicle aids: keyword, the option of its file, and its columns.
 _VEHICLE = (
     ("rest", "zupt", lambda t: _columns(t, REST_COLUMNS, "rest")),
     ("odometer", "odometer", lambda t: _columns(t, ODOMETER_COLUMNS, "odometer")),
-    ("heading", "dual-antenna", _heading),
+    ("heading", "dual_antenna", _heading),
 )
 
 
@@ -195,7 +217,7 @@ def read_imu(path: PathLike, **options: Any) -> pd.DataFrame:
     ``start``, ``end`` [s]. Columns: ``t_s`` (interval end), ``dt_s``,
     ``dtheta_{x,y,z}_rad``, ``dvel_{x,y,z}_mps`` (vehicle FRD axes).
     """
-    return _frame(_schuler.read_imu(os.fspath(path), _flags(options)))
+    return _frame(_schuler.read_imu(os.fspath(path), _options(options)))
 
 
 def read_gnss(path: PathLike, **options: Any) -> pd.DataFrame:
@@ -207,7 +229,7 @@ def read_gnss(path: PathLike, **options: Any) -> pd.DataFrame:
     ``lat_deg``, ``lon_deg``, ``h_m``, ``std_{n,e,d}_m``, ``v{n,e,d}_mps`` and
     ``std_v{n,e,d}_mps`` (NaN where a fix has no velocity).
     """
-    return _frame(_schuler.read_gnss(os.fspath(path), _flags(options)))
+    return _frame(_schuler.read_gnss(os.fspath(path), _options(options)))
 
 
 def read_baro(path: PathLike) -> pd.DataFrame:
@@ -325,30 +347,30 @@ def navigate(
     the same with the heading found by a bank of 12 filters (both need ``gnss``).
     The GIL is released while the run goes on.
     """
-    flags = _flags(options)
+    opts = _options(options)
     kwargs: Dict[str, Any] = {}
     if isinstance(imu, (str, os.PathLike)):
-        flags.append(f"--imu={os.fspath(imu)}")
+        opts["imu"] = os.fspath(imu)
     else:
         cols, dt = _imu(imu)
-        flags.append("--imu=<imu array>")
+        opts["imu"] = "<imu array>"
         kwargs.update(imu=cols, imu_dt=dt)
     if isinstance(gnss, (str, os.PathLike)):
-        flags.append(f"--gnss={os.fspath(gnss)}")
+        opts["gnss"] = os.fspath(gnss)
     elif gnss is not None:
         kwargs["gnss"] = _gnss(gnss)
     if isinstance(baro, (str, os.PathLike)):
-        flags.append(f"--baro={os.fspath(baro)}")
+        opts["baro"] = os.fspath(baro)
     elif baro is not None:
         kwargs["baro"] = _baro(baro)
     given = dict(odometer=odometer, heading=heading, rest=rest)
-    for name, flag, columns in _VEHICLE:
+    for name, option, columns in _VEHICLE:
         table = given[name]
         if isinstance(table, (str, os.PathLike)):
-            flags.append(f"--{flag}={os.fspath(table)}")
+            opts[option] = os.fspath(table)
         elif table is not None:
             kwargs[name] = columns(table)
-    return NavResult._of(_schuler.navigate(flags, **kwargs))
+    return NavResult._of(_schuler.navigate(opts, **kwargs))
 
 
 class Session:
@@ -373,8 +395,8 @@ class Session:
         rest: bool = False,
         **options: Any,
     ) -> None:
-        flags = _flags(options) + ["--imu=<session>"]
-        self._native = _schuler.Session(flags, gnss, baro, rest=rest, odometer=odometer, heading=heading)
+        opts = {**_options(options), "imu": "<session>"}
+        self._native = _schuler.Session(opts, gnss, baro, rest=rest, odometer=odometer, heading=heading)
 
     def push_imu(self, t: float, dtheta: Sequence[float], dvel: Sequence[float], dt: Optional[float] = None) -> None:
         """One IMU sample: interval end ``t`` [s], increments ``dtheta`` [rad] and
@@ -510,7 +532,7 @@ def allan(imu: Union[PathLike, Table], per_decade: float = 10.0, max_tau: Option
     ``options``) or a table as :func:`navigate`'s. Columns ``tau_s``, ``m`` (cluster
     size), ``gyro_{x,y,z}_radps``, ``accel_{x,y,z}_mps2``."""
     if isinstance(imu, (str, os.PathLike)):
-        d = _schuler.allan(path=os.fspath(imu), flags=_flags(options), per_decade=per_decade, max_tau=max_tau)
+        d = _schuler.allan(path=os.fspath(imu), options=_options(options), per_decade=per_decade, max_tau=max_tau)
     else:
         if options:
             raise TypeError("reading options apply to files only")
@@ -561,7 +583,7 @@ def montecarlo(
     ``[navigate]`` table of ``schuler nav`` options and an optional ``[campaign]``
     table), run ``k`` with the scenario seed ``seed + k``: simulated, navigated from
     the truth at its first sample, compared with the truth. ``options`` are nav's
-    flags added after ``[navigate]``'s (they win). Returns one row per run, the
+    options over ``[navigate]``'s (they win). Returns one row per run, the
     columns of ``runs.csv`` (``seed``, then :data:`CAMPAIGN_COLUMNS`: error statistics
     [m, m/s, deg], time-averaged NEES of position, velocity and attitude (3 dof each),
     mean NIS per dof, rejected measurements), the same bits for any ``threads``
@@ -569,7 +591,7 @@ def montecarlo(
     if runs < 1:
         raise ValueError("runs must be at least 1")
     seeds = [(seed + k) % 2**64 for k in range(runs)]
-    d = _schuler.montecarlo_seeds(seeds, flags=_flags(options), threads=threads, **_campaign_source(campaign))
+    d = _schuler.montecarlo_seeds(seeds, options=_options(options), threads=threads, **_campaign_source(campaign))
     return _campaign_frame(d)
 
 
@@ -614,11 +636,11 @@ def align(imu: Union[PathLike, Table], pos: Sequence[float], **options: Any) -> 
     ``imu_grade``, ``heading`` (``"DEG"`` or ``"DEG,STD_DEG"``: an external heading
     instead of gyrocompassing), ``max_heading_std`` [deg], ``start`` [s], ``earth``,
     and the IMU input options. The GIL is released while it runs."""
-    flags = _flags(options) + [f"--pos={_value(pos)}"]
+    opts = {**_options(options), "pos": _plain("pos", pos)}
     if isinstance(imu, (str, os.PathLike)):
-        return AlignResult._of(_schuler.align(flags + [f"--imu={os.fspath(imu)}"]))
+        return AlignResult._of(_schuler.align({**opts, "imu": os.fspath(imu)}))
     cols, dt = _imu(imu)
-    return AlignResult._of(_schuler.align(flags + ["--imu=<imu array>"], imu=cols, imu_dt=dt))
+    return AlignResult._of(_schuler.align({**opts, "imu": "<imu array>"}, imu=cols, imu_dt=dt))
 
 
 @dataclass

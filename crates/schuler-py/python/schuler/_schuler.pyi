@@ -21,12 +21,15 @@ CAMPAIGN_COLUMNS: List[str]
 #: Columns of a navigation table: ``t_s``, ``lat_deg`` [deg], ... ``yaw_deg`` [deg].
 NAV_COLUMNS: List[str]
 
-def read_imu(path: str, flags: List[str]) -> Dict[str, F64]: ...
-def read_gnss(path: str, flags: List[str]) -> Dict[str, F64]: ...
+#: A run's description: ``schuler nav``'s flags with underscores as keys, plain values.
+Options = Dict[str, Any]
+
+def read_imu(path: str, options: Options) -> Dict[str, F64]: ...
+def read_gnss(path: str, options: Options) -> Dict[str, F64]: ...
 def read_baro(path: str) -> Dict[str, List[float]]: ...
 def read_nav(path: str) -> Dict[str, F64]: ...
 def navigate(
-    flags: List[str],
+    options: Options,
     imu: Optional[Sequence[F64]] = None,
     imu_dt: Optional[F64] = None,
     gnss: Optional[Sequence[F64]] = None,
@@ -43,7 +46,7 @@ def navigate(
 class Session:
     def __init__(
         self,
-        flags: List[str],
+        options: Options,
         gnss: bool = False,
         baro: bool = False,
         rest: bool = False,
@@ -96,7 +99,7 @@ def compare(
 ) -> Dict[str, Any]: ...
 def allan(
     path: Optional[str] = None,
-    flags: List[str] = ...,
+    options: Optional[Options] = None,
     imu: Optional[Sequence[F64]] = None,
     imu_dt: Optional[F64] = None,
     per_decade: float = 10.0,
@@ -108,7 +111,7 @@ def montecarlo_seeds(
     text: Optional[str] = None,
     format: str = "toml",
     base: Optional[str] = None,
-    flags: List[str] = ...,
+    options: Optional[Options] = None,
     threads: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def allan_fit(
@@ -119,7 +122,7 @@ def allan_fit(
     ...
 
 def align(
-    flags: List[str], imu: Optional[Sequence[F64]] = None, imu_dt: Optional[F64] = None
+    options: Options, imu: Optional[Sequence[F64]] = None, imu_dt: Optional[F64] = None
 ) -> Dict[str, Any]:
     """``schuler align``: ``summary`` (align.json text), ``convergence`` [s, deg,
     deg/h, mGal], ``report``."""

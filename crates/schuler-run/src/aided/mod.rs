@@ -146,6 +146,7 @@ pub struct AidingOptions {
     /// onto an IMU clock in UTC; NMEA and RTKLIB times are GPS seconds of week, NMEA
     /// without a date UTC seconds of day).
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub gnss_time_offset: Option<String>,
     /// GNSS velocity log matched to the fixes by time: text t vn ve vd [std_vn std_ve
     /// std_vd] or CSV naming t,vn_mps,ve_mps,vd_mps[,std_vn_mps,...] (gnss.csv too); a
@@ -155,6 +156,7 @@ pub struct AidingOptions {
     /// Velocity standard deviation where the velocity log, or a position log's velocity
     /// (NMEA speed and course, RTKLIB vn ve vu), gives none (default 0.1 m/s).
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub gnss_vel_std: Option<String>,
     /// Antenna position in body axes, front, right, down [m].
     #[arg(
@@ -184,39 +186,50 @@ pub struct AidingOptions {
     pub smooth: bool,
     /// Angle random walk (e.g. `0.1 deg/sqrt(h)`; default from --imu-grade).
     #[arg(long, allow_hyphen_values = true, value_name = "ARW")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub arw: Option<String>,
     /// Velocity random walk (e.g. `0.08 m/s/sqrt(h)`).
     #[arg(long, allow_hyphen_values = true, value_name = "VRW")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub vrw: Option<String>,
     /// Gyro bias standard deviation (e.g. `2 deg/h`).
     #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub gyro_bias_std: Option<String>,
     /// Accelerometer bias standard deviation (e.g. `300 mGal`).
     #[arg(long, allow_hyphen_values = true, value_name = "ACCEL")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub accel_bias_std: Option<String>,
     /// Gyro scale-factor standard deviation (e.g. `1000 ppm`; with --scale-factors).
     #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub gyro_scale_std: Option<String>,
     /// Accelerometer scale-factor standard deviation.
     #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub accel_scale_std: Option<String>,
     /// Bias instability (Gauss–Markov std, e.g. `0.2 deg/h` and `2e-4 m/s^2`) with
     /// --bias-corr-time: sets the bias random walk.
     #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub gyro_bias_instability: Option<String>,
     /// Accelerometer bias instability.
     #[arg(long, allow_hyphen_values = true, value_name = "ACCEL")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub accel_bias_instability: Option<String>,
     /// Correlation time of the bias instability (default 1 h); given, the biases are
     /// modelled as first-order Gauss–Markov processes, otherwise as random walks.
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub bias_corr_time: Option<String>,
     /// Gyro rate random walk (e.g. `0.01 deg/h/sqrt(h)`): added in quadrature to the
     /// gyro bias's driving noise (the instability's, or --imu-grade's).
     #[arg(long, allow_hyphen_values = true, value_name = "RRW")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub rate_random_walk: Option<String>,
     /// Accelerometer acceleration random walk (e.g. `10 ug/sqrt(h)`), likewise.
     #[arg(long, allow_hyphen_values = true, value_name = "ARW")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub acceleration_random_walk: Option<String>,
     /// Initial position standard deviation north, east, down [m] (default 1,1,1).
     #[arg(long, allow_hyphen_values = true, value_name = "N,E,D")]
@@ -233,14 +246,17 @@ pub struct AidingOptions {
     pub baro: Option<PathBuf>,
     /// Barometer noise standard deviation (default 0.5 m).
     #[arg(long, allow_hyphen_values = true, value_name = "LENGTH")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub baro_std: Option<String>,
     /// Prior standard deviation of the barometer bias (default 10 m).
     #[arg(long, allow_hyphen_values = true, value_name = "LENGTH")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub baro_bias_std: Option<String>,
     /// Outage test: remove GNSS for LEN every PERIOD (e.g. `60s/180s`), the first
     /// outage starting at --outage-start (default: one PERIOD after the first fix);
     /// with --truth, report the errors at the end of and inside each outage.
     #[arg(long, allow_hyphen_values = true, value_name = "LEN/PERIOD")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub outage_test: Option<String>,
     /// Start of the first test outage [s, the log's clock].
     #[arg(long, allow_hyphen_values = true, value_name = "SOW")]
@@ -261,6 +277,7 @@ pub struct AidingOptions {
     /// Longest covariance propagation step (default 1 s; the covariance is always
     /// propagated to each measurement's time).
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub propagation_interval: Option<String>,
     /// Zero-velocity updates inside the rest intervals of FILE (`t0 t1` per line).
     #[arg(
@@ -278,14 +295,17 @@ pub struct AidingOptions {
     pub zupt_detect: bool,
     /// Zero-velocity standard deviation (default 0.02 m/s).
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub zupt_std: Option<String>,
     /// Time between zero-velocity updates at rest, and the detector's block
     /// (default 0.1 s; the detector's window is ten blocks).
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub zupt_interval: Option<String>,
     /// --zupt-detect: no update while the navigation's speed exceeds this (an IMU
     /// cannot tell rest from constant velocity; default 0.5 m/s).
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub zupt_max_speed: Option<String>,
     /// With each zero-velocity update, a zero-angular-rate update on the gyro biases
     /// (the body turns with the Earth only).
@@ -295,6 +315,7 @@ pub struct AidingOptions {
     /// Standard deviation of the rate averaged over --zupt-interval (default: the angle
     /// random walk over that time, ARW/sqrt(interval)).
     #[arg(long, allow_hyphen_values = true, value_name = "RATE")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub zaru_std: Option<String>,
     /// Non-holonomic constraint of a land vehicle: no lateral or vertical velocity of
     /// the vehicle frame at --vehicle-lever-arm.
@@ -303,19 +324,23 @@ pub struct AidingOptions {
     pub nhc: bool,
     /// NHC standard deviation (default 0.1 m/s).
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub nhc_std: Option<String>,
     /// Time between NHC updates (default 0.1 s).
     #[arg(long, allow_hyphen_values = true, value_name = "TIME")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub nhc_interval: Option<String>,
     /// Odometer log (`t speed` per line, forward speed in m/s at --vehicle-lever-arm).
     #[arg(long, allow_hyphen_values = true, value_name = "FILE")]
     pub odometer: Option<PathBuf>,
     /// Odometer speed standard deviation (default 0.05 m/s).
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub odometer_std: Option<String>,
     /// Estimate the odometer's scale factor with this prior standard deviation (e.g.
     /// `1 %`).
     #[arg(long, allow_hyphen_values = true, value_name = "RATIO")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub odometer_scale_std: Option<String>,
     /// Mounting angles: the vehicle frame's roll, pitch, yaw relative to the IMU body
     /// [deg] (0,0,0 when the IMU's axes are the vehicle's front, right, down).
@@ -325,6 +350,7 @@ pub struct AidingOptions {
     /// filter states (needs --nhc or --odometer), prior standard deviation (e.g.
     /// `5 deg`; the flag alone: 5 deg).
     #[arg(long, value_name = "ANGLE", num_args = 0..=1, default_missing_value = "5 deg")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub estimate_mounting: Option<String>,
     /// The point the NHC and the odometer speak of (the rear axle's centre, the
     /// odometer wheel) in IMU body axes, front, right, down [m] (default 0,0,0).

@@ -1,8 +1,9 @@
 //! A campaign's configuration: one TOML file holding a `schuler simulate` scenario
 //! (its keys at the top level, the seed replaced run by run), the `[navigate]` table
-//! with `schuler nav`'s options (each key is a flag without its dashes: `lever_arm =
+//! with `schuler nav`'s options (each key a flag's name with underscores: `lever_arm =
 //! [0.5, 0.0, -1.0]` is `--lever-arm=0.5,0,-1`; `[navigate.aiding]` and
-//! `[navigate.alignment]` may group them as in nav's own config) and the
+//! `[navigate.alignment]` may group them as in nav's own config), read as nav's
+//! description ([`crate::nav::NavConfig::from_options`]), and the
 //! `[campaign]` table saying which simulated streams the filter gets.
 
 use anyhow::{Context, Result, bail};
@@ -44,8 +45,9 @@ impl Default for Streams {
 pub struct CampaignConfig {
     /// The scenario (its `seed` is replaced by each run's).
     pub scenario: ScenarioSpec,
-    /// `schuler nav`'s flags from `[navigate]`.
-    pub nav_flags: Vec<String>,
+    /// `schuler nav`'s options from `[navigate]`, flat (its sub-tables' keys beside
+    /// its own).
+    pub nav_options: toml::Table,
     /// The streams the filter is given.
     pub streams: Streams,
     /// What the configuration came from (its file), for messages.
@@ -73,28 +75,28 @@ impl CampaignConfig {
             .try_into()
             .with_context(|| format!("in {origin}: the scenario"))?;
         let scenario = crate::scenario::with_motion_csv(scenario, dir)?;
-        let mut nav_flags = Vec::new();
+        let mut nav_options = toml::Table::new();
         if let Some(nav) = nav {
             let toml::Value::Table(t) = nav else {
                 bail!("in {origin}: `navigate` must be a table of `schuler nav` options");
             };
-            flags_of(&t, &mut nav_flags).with_context(|| format!("in {origin}: [navigate]"))?;
+            flatten(t, &mut nav_options);
+            // Refused here, before any run, naming the option.
+            crate::nav::NavConfig::from_options(nav_options.clone())
+                .with_context(|| format!("in {origin}: [navigate]"))?;
         }
         Ok(Self {
             scenario,
-            nav_flags,
+            nav_options,
             streams,
             origin: origin.to_string(),
         })
     }
 
-    /// The configuration with `flags` over `[navigate]`'s: a flag given in both is
-    /// `flags`' alone.
-    pub fn with_flags(mut self, flags: &[String]) -> Self {
-        let name = |f: &str| f.split('=').next().unwrap_or(f).to_string();
-        let given: Vec<String> = flags.iter().map(|f| name(f)).collect();
-        self.nav_flags.retain(|f| !given.contains(&name(f)));
-        self.nav_flags.extend_from_slice(flags);
+    /// The configuration with `options` over `[navigate]`'s: an option given in both
+    /// is `options`' alone.
+    pub fn with_options(mut self, options: toml::Table) -> Self {
+        self.nav_options.extend(options);
         self
     }
 
@@ -106,34 +108,17 @@ impl CampaignConfig {
     }
 }
 
-/// `schuler nav`'s flags of a table of options: `key = value` is `--key=value` (`_`
-/// as `-`), an array's items joined by commas, `true` the bare flag, `false` nothing;
-/// sub-tables (`aiding`, `alignment`) add theirs.
-fn flags_of(table: &toml::Table, flags: &mut Vec<String>) -> Result<()> {
+/// The options of `table` into `out`, a sub-table's (`aiding`, `alignment`) beside
+/// the table's own.
+fn flatten(table: toml::Table, out: &mut toml::Table) {
     for (key, value) in table {
-        let flag = format!("--{}", key.replace('_', "-"));
         match value {
-            toml::Value::Table(t) => flags_of(t, flags)?,
-            toml::Value::Boolean(true) => flags.push(flag),
-            toml::Value::Boolean(false) => {}
-            toml::Value::Array(items) => {
-                let items: Result<Vec<String>> = items.iter().map(|v| scalar(key, v)).collect();
-                flags.push(format!("{flag}={}", items?.join(",")));
+            toml::Value::Table(t) => flatten(t, out),
+            v => {
+                out.insert(key, v);
             }
-            v => flags.push(format!("{flag}={}", scalar(key, v)?)),
         }
     }
-    Ok(())
-}
-
-/// A number or a string as the flag's text (a float in its shortest exact form).
-fn scalar(key: &str, v: &toml::Value) -> Result<String> {
-    Ok(match v {
-        toml::Value::String(s) => s.clone(),
-        toml::Value::Integer(i) => i.to_string(),
-        toml::Value::Float(x) => format!("{x:?}"),
-        _ => bail!("`{key}`: a number, a string or an array of them expected, got {v}"),
-    })
 }
 
 #[cfg(test)]
@@ -164,36 +149,26 @@ baro_std = "0.5 m"
 "#;
 
     #[test]
-    fn the_navigate_table_becomes_nav_flags_and_the_rest_the_scenario() {
+    fn the_navigate_table_becomes_nav_options_and_the_rest_the_scenario() {
         let c = CampaignConfig::from_toml(TEXT, Path::new(""), "test").expect("valid");
         assert_eq!(c.scenario.seed, 3);
         assert!(c.streams.baro && c.streams.gnss && !c.streams.gnss_velocity);
-        // toml's tables keep their keys sorted.
-        assert_eq!(
-            c.nav_flags,
-            [
-                "--baro-std=0.5 m",
-                "--lever-arm=0.5,0,-1.0",
-                "--nhc",
-                "--imu-grade=tactical",
-                "--output-rate=1.0"
-            ]
-        );
+        let flat: toml::Table = "output_rate = 1.0\nimu_grade = 'tactical'\n\
+             lever_arm = [0.5, 0, -1.0]\nnhc = true\nsmooth = false\nbaro_std = '0.5 m'"
+            .parse()
+            .expect("toml");
+        assert_eq!(c.nav_options, flat);
     }
 
     #[test]
-    fn a_wrong_value_names_its_key() {
-        let text = TEXT.replace("nhc = true", "nhc = { a = 1 }\nx = [{ a = 1 }]");
-        let e = CampaignConfig::from_toml(&text, Path::new(""), "test").expect_err("refused");
-        assert!(format!("{e:#}").contains("`x`"), "{e:#}");
-    }
-
-    #[test]
-    fn given_flags_replace_the_tables() {
+    fn given_options_replace_the_tables() {
         let c = CampaignConfig::from_toml(TEXT, Path::new(""), "test").expect("valid");
-        let c = c.with_flags(&["--imu-grade=navigation".into(), "--smooth".into()]);
-        let grades: Vec<&String> = c.nav_flags.iter().filter(|f| f.contains("grade")).collect();
-        assert_eq!(grades, ["--imu-grade=navigation"]);
-        assert_eq!(c.nav_flags.last().map(String::as_str), Some("--smooth"));
+        let given: toml::Table = "imu_grade = 'navigation'\nsmooth = true"
+            .parse()
+            .expect("toml");
+        let c = c.with_options(given);
+        assert_eq!(c.nav_options["imu_grade"].as_str(), Some("navigation"));
+        assert_eq!(c.nav_options["smooth"].as_bool(), Some(true));
+        assert_eq!(c.nav_options.len(), 6);
     }
 }

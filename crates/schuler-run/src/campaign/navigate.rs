@@ -6,44 +6,13 @@
 use super::config::{CampaignConfig, Streams};
 use super::record::Recorded;
 use crate::aided::GivenReadings;
-use crate::nav::{InitChoice, NavArgs, parse_nav_args, resolve_aiding};
+use crate::nav::{InitChoice, NavConfig, plan_of, resolve_aiding};
 use crate::navigate::{NavSettings, open_session};
 use crate::options::EarthChoice;
 use anyhow::{Context, Result, bail};
-use clap::Parser;
 use schuler::analysis::errors::NavRecord;
 use schuler::earth::{EarthModel, Sphere, Wgs84, Wgs84Series};
 use schuler::session::Finished;
-
-/// `schuler nav`'s options as a parser of a flag list.
-#[derive(Parser, Debug)]
-#[command(name = "navigate", no_binary_name = true)]
-struct NavFlags {
-    #[command(flatten)]
-    args: NavArgs,
-}
-
-/// `schuler nav`'s arguments from `flags` (`--key=value` or `--key value`); a refusal
-/// is clap's error (the Python package makes it a `TypeError`).
-pub fn nav_args(flags: &[String]) -> Result<NavArgs> {
-    Ok(NavFlags::try_parse_from(flags)?.args)
-}
-
-/// [`nav_args`] with a refusal as clap's message on one line, without its usage hint.
-fn nav_args_one_line(flags: &[String]) -> Result<NavArgs> {
-    NavFlags::try_parse_from(flags)
-        .map(|f| f.args)
-        .map_err(|e| {
-            let text = e.render().to_string();
-            let message: Vec<&str> = text
-                .lines()
-                .map(str::trim)
-                .take_while(|l| !l.starts_with("For more information") && !l.starts_with("Usage:"))
-                .filter(|l| !l.is_empty())
-                .collect();
-            anyhow::anyhow!("{}", message.join(" ").trim_start_matches("error: "))
-        })
-}
 
 /// What navigating one run gave.
 #[derive(Debug)]
@@ -54,28 +23,32 @@ pub struct Navigated {
     pub finished: Finished,
 }
 
-/// The flags that start a run at the simulated truth of its first sample (the carrier
-/// of the start), in nav's units (degrees), after the campaign's own.
-fn start_flags(nav_flags: &[String], first: &NavRecord) -> Vec<String> {
+/// The options that start a run at the simulated truth of its first sample (the
+/// carrier of the start), in nav's units (degrees), over the campaign's own.
+fn start_options(nav_options: &toml::Table, first: &NavRecord) -> toml::Table {
     let (p, v, a) = (&first.pos, &first.v_n, &first.att);
-    let mut flags = nav_flags.to_vec();
-    flags.extend([
-        "--imu=<simulated>".to_string(),
-        format!(
-            "--init-pos={:?},{:?},{:?}",
-            p.lat.to_degrees(),
-            p.lon.to_degrees(),
-            p.h
+    let triple = |x: [f64; 3]| toml::Value::Array(x.map(toml::Value::Float).to_vec());
+    let mut options = nav_options.clone();
+    options.extend([
+        (
+            "imu".to_owned(),
+            toml::Value::String("<simulated>".to_owned()),
         ),
-        format!("--init-vel={:?},{:?},{:?}", v.x, v.y, v.z),
-        format!(
-            "--init-att={:?},{:?},{:?}",
-            a.roll.to_degrees(),
-            a.pitch.to_degrees(),
-            a.yaw.to_degrees()
+        (
+            "init_pos".to_owned(),
+            triple([p.lat.to_degrees(), p.lon.to_degrees(), p.h]),
+        ),
+        ("init_vel".to_owned(), triple([v.x, v.y, v.z])),
+        (
+            "init_att".to_owned(),
+            triple([
+                a.roll.to_degrees(),
+                a.pitch.to_degrees(),
+                a.yaw.to_degrees(),
+            ]),
         ),
     ]);
-    flags
+    options
 }
 
 /// The readings of `data` the streams choose, as nav's given readings.
@@ -107,7 +80,10 @@ pub fn navigate(c: &CampaignConfig, data: &Recorded) -> Result<Navigated> {
         .truth
         .first()
         .context("the simulation gave no IMU sample")?;
-    let plan = parse_nav_args(nav_args_one_line(&start_flags(&c.nav_flags, first))?)?;
+    let plan = plan_of(NavConfig::from_options(start_options(
+        &c.nav_options,
+        first,
+    ))?)?;
     if plan.align || plan.init != InitChoice::Given {
         bail!(
             "a campaign starts at the simulated truth: `align` and `init` are not \

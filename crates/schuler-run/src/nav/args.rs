@@ -4,6 +4,7 @@
 use crate::aided::AidingOptions;
 use crate::alignment::AlignOptions;
 use crate::bag_input::BagArgs;
+use crate::flat_options::{keys_of, partition, read_group, unknown_option};
 use crate::imu_input::ImuInputOptions;
 use crate::options::{EarthChoice, GravityChoice, MechanizationChoice, Triple};
 use anyhow::{Context, Result};
@@ -102,39 +103,41 @@ pub struct NavArgs {
     pub bag: BagArgs,
 }
 
-/// The same options as a TOML file.
+/// The same options as data: a TOML file's keys ([`load_config`]; alignment options in
+/// its `[alignment]` table, aiding options in `[aiding]`) or flat options by name
+/// ([`NavConfig::from_options`]: Python's keyword arguments).
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(super) struct NavConfig {
-    pub(super) imu: Option<PathBuf>,
-    pub(super) init_pos: Option<Triple>,
-    pub(super) init_vel: Option<Triple>,
-    pub(super) init_att: Option<Triple>,
-    pub(super) start: Option<f64>,
-    pub(super) end: Option<f64>,
-    pub(super) output_rate: Option<f64>,
-    pub(super) out: Option<PathBuf>,
-    pub(super) earth: Option<EarthChoice>,
-    pub(super) gravity: Option<GravityChoice>,
-    pub(super) week: Option<u32>,
-    pub(super) mechanization: Option<MechanizationChoice>,
-    pub(super) auto_latitude: Option<f64>,
-    pub(super) auto_hysteresis: Option<f64>,
-    pub(super) align: Option<bool>,
-    pub(super) init: Option<InitChoice>,
-    pub(super) alignment: Option<AlignOptions>,
-    pub(super) aiding: Option<AidingOptions>,
-    pub(super) bag: Option<PathBuf>,
-    pub(super) imu_topic: Option<String>,
-    pub(super) gnss_topic: Option<String>,
-    pub(super) gnss_vel_topic: Option<String>,
-    pub(super) baro_topic: Option<String>,
-    pub(super) odom_topic: Option<String>,
-    pub(super) out_bag: Option<PathBuf>,
-    pub(super) leap_seconds: Option<i64>,
+pub struct NavConfig {
+    pub(crate) imu: Option<PathBuf>,
+    pub(crate) init_pos: Option<Triple>,
+    pub(crate) init_vel: Option<Triple>,
+    pub(crate) init_att: Option<Triple>,
+    pub(crate) start: Option<f64>,
+    pub(crate) end: Option<f64>,
+    pub(crate) output_rate: Option<f64>,
+    pub(crate) out: Option<PathBuf>,
+    pub(crate) earth: Option<EarthChoice>,
+    pub(crate) gravity: Option<GravityChoice>,
+    pub(crate) week: Option<u32>,
+    pub(crate) mechanization: Option<MechanizationChoice>,
+    pub(crate) auto_latitude: Option<f64>,
+    pub(crate) auto_hysteresis: Option<f64>,
+    pub(crate) align: Option<bool>,
+    pub(crate) init: Option<InitChoice>,
+    pub(crate) alignment: Option<AlignOptions>,
+    pub(crate) aiding: Option<AidingOptions>,
+    pub(crate) bag: Option<PathBuf>,
+    pub(crate) imu_topic: Option<String>,
+    pub(crate) gnss_topic: Option<String>,
+    pub(crate) gnss_vel_topic: Option<String>,
+    pub(crate) baro_topic: Option<String>,
+    pub(crate) odom_topic: Option<String>,
+    pub(crate) out_bag: Option<PathBuf>,
+    pub(crate) leap_seconds: Option<i64>,
     /// The IMU input keys, read apart ([`ImuInputOptions::split_config`]).
     #[serde(skip)]
-    pub(super) input: ImuInputOptions,
+    pub(crate) input: ImuInputOptions,
 }
 
 /// How a run starts.
@@ -168,6 +171,29 @@ pub(super) fn load_config(path: &Path) -> Result<NavConfig> {
 }
 
 impl NavConfig {
+    /// A run described by flat options, each the name of a flag with underscores
+    /// (`lever_arm`, `imu_grade`, `gnss`): each goes to the group that owns it and is
+    /// read by serde, so that a misspelt name or a bad value is refused naming the
+    /// option. Paths are taken as given (relative to the working directory).
+    pub fn from_options(options: toml::Table) -> Result<Self> {
+        let input_keys = ImuInputOptions::keys();
+        let align_keys = keys_of::<AlignOptions>();
+        let aid_keys = keys_of::<AidingOptions>();
+        let (groups, top) = partition(options, &[&input_keys, &align_keys, &aid_keys]);
+        let known = keys_of::<NavArgs>();
+        if let Some(k) = top.keys().find(|k| !known.contains(k)) {
+            return Err(unknown_option(k, &known));
+        }
+        let [input, alignment, aiding] = <[toml::Table; 3]>::try_from(groups)
+            .map_err(|_| anyhow::anyhow!("three option groups"))?;
+        Ok(Self {
+            input: read_group(input)?,
+            alignment: Some(read_group(alignment)?),
+            aiding: Some(read_group(aiding)?),
+            ..read_group(top)?
+        })
+    }
+
     /// The bag keys (paths already relative to the file's folder).
     pub(super) fn bag_args(&self) -> BagArgs {
         BagArgs {

@@ -18,7 +18,7 @@ pub mod plan;
 pub mod run;
 pub mod start;
 
-pub use args::{InitChoice, NavArgs};
-pub use plan::{NavPlan, filter_grade, parse_nav_args, resolve_aiding};
+pub use args::{InitChoice, NavArgs, NavConfig};
+pub use plan::{NavPlan, filter_grade, parse_nav_args, plan_of, resolve_aiding};
 pub use run::{Navigated, navigate_samples};
 pub use start::{BANK_MEMBERS, BANK_SECONDS, Began, align_start, begin, motion_start};

@@ -108,17 +108,21 @@ fn read_options(args: &NavArgs, cfg: &NavConfig) -> Result<ImuReadOptions> {
 pub fn parse_nav_args(args: NavArgs) -> Result<NavPlan> {
     // A value may come from the configuration file: its errors name it.
     match args.config.clone() {
-        Some(config) => plan(args).with_context(|| format!("with --config {}", config.display())),
-        None => plan(args),
+        Some(config) => load_config(&config)
+            .and_then(|cfg| plan(args, cfg))
+            .with_context(|| format!("with --config {}", config.display())),
+        None => plan(args, NavConfig::default()),
     }
 }
 
-/// [`parse_nav_args`] itself.
-fn plan(args: NavArgs) -> Result<NavPlan> {
-    let cfg = match &args.config {
-        Some(p) => load_config(p)?,
-        None => NavConfig::default(),
-    };
+/// The plan of a run described as data alone ([`NavConfig::from_options`]: Python's
+/// keyword arguments), every value checked as [`parse_nav_args`] checks flags.
+pub fn plan_of(description: NavConfig) -> Result<NavPlan> {
+    plan(NavArgs::default(), description)
+}
+
+/// [`parse_nav_args`] itself: `args` over `cfg`.
+fn plan(args: NavArgs, cfg: NavConfig) -> Result<NavPlan> {
     let align_on = args.align || cfg.align.unwrap_or(false);
     let init = args.init.or(cfg.init).unwrap_or_default();
     // In motion the fixes give the position and the course (or the bank) the attitude.
@@ -257,4 +261,82 @@ pub fn resolve_aiding(
 ) -> Result<Option<Aiding>> {
     let noise = grade(alignment, aiding.any() || given.any()).noise()?;
     aiding.resolve_with(noise, given)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nav::NavConfig;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    #[command(no_binary_name = true)]
+    struct Flags {
+        #[command(flatten)]
+        args: NavArgs,
+    }
+
+    fn of_flags(flags: &[&str]) -> Result<NavPlan> {
+        parse_nav_args(Flags::try_parse_from(flags)?.args)
+    }
+
+    fn of_options(toml: &str) -> Result<NavPlan> {
+        plan_of(NavConfig::from_options(toml.parse()?)?)
+    }
+
+    #[test]
+    fn options_by_name_plan_the_run_their_flags_plan() {
+        let flags = [
+            "--imu=IMU.txt",
+            "--init-pos=45.07,7.68,245",
+            "--init-att=0,0,10",
+            "--output-rate=10",
+            "--gyro-unit=deg/s",
+            "--imu-grade=tactical",
+            "--coarse=30 s",
+            "--gnss=gnss.txt",
+            "--lever-arm=0.5,0,-1",
+            "--baro-std=0.5",
+            "--nhc",
+            "--smooth",
+        ];
+        let options = r#"
+            imu = "IMU.txt"
+            init_pos = [45.07, 7.68, 245]
+            init_att = [0, 0, 10]
+            output_rate = 10
+            gyro_unit = "deg/s"
+            imu_grade = "tactical"
+            coarse = "30 s"
+            gnss = "gnss.txt"
+            lever_arm = [0.5, 0, -1]
+            baro_std = 0.5
+            nhc = true
+            smooth = true
+        "#;
+        let (a, b) = (
+            of_flags(&flags).expect("flags"),
+            of_options(options).expect("options"),
+        );
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    }
+
+    #[test]
+    fn options_by_name_are_refused_naming_the_option() {
+        let msg = |toml: &str| of_options(toml).unwrap_err().to_string();
+        let e = msg("lever_arms = [1, 2, 3]");
+        assert_eq!(e, "unknown option `lever_arms` (did you mean `lever_arm`?)");
+        let e = msg("lever_arm = [1, 2]");
+        assert!(e.starts_with("option `lever_arm`: invalid length 2"), "{e}");
+        let e = msg("imu_grade = \"superb\"");
+        assert!(
+            e.starts_with("option `imu_grade`: unknown variant `superb`"),
+            "{e}"
+        );
+        let e = msg("init = 3");
+        assert!(e.starts_with("option `init`: "), "{e}");
+        // The domain checks are the flags' own.
+        let e = msg("imu = \"x\"\ninit_pos = [95, 0, 0]");
+        assert!(e.contains("latitude"), "{e}");
+    }
 }
