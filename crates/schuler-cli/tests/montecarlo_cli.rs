@@ -109,9 +109,9 @@ fn a_bad_campaign_is_refused_with_its_file_named() {
         .assert()
         .failure();
     let err = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
-    // The first seed's error, whichever thread failed first.
+    // Refused before any run, naming the file, the table and the option.
     assert!(
-        err.contains("bad.toml: the run with seed 1:") && err.contains("wrong"),
+        err.contains("bad.toml: [navigate]: option `imu_grade`: unknown variant `wrong`"),
         "{err}"
     );
 }

@@ -42,14 +42,16 @@ def test_montecarlo_equals_the_cli_table(cli, tmp_path):
     _assert_same_bits(table, one)
 
 
-def test_options_win_over_the_campaign_and_errors_name_the_seed():
+def test_options_win_over_the_campaign_and_are_checked_before_any_run():
     base = schuler.montecarlo(CAMPAIGN, runs=2, seed=3)
     # A navigation-grade noise model told to the filter of a tactical IMU: the same
     # samples, an overconfident filter (NEES far above its 3 dof).
     wrong = schuler.montecarlo(CAMPAIGN, runs=2, seed=3, imu_grade="navigation")
     assert (wrong["nees_attitude"] > 3 * base["nees_attitude"]).any()
-    with pytest.raises(schuler.SchulerError, match="seed 3"):
+    with pytest.raises(schuler.SchulerError, match="^option `imu_grade`: unknown variant `no-such-grade`"):
         schuler.montecarlo(CAMPAIGN, runs=1, seed=3, imu_grade="no-such-grade")
+    with pytest.raises(TypeError, match=r"^unknown option `imu_grades` \(did you mean `imu_grade`\?\)$"):
+        schuler.montecarlo(CAMPAIGN, runs=1, seed=3, imu_grades="tactical")
 
 
 def test_dask_cluster_gives_the_local_table():

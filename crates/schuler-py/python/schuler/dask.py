@@ -29,14 +29,14 @@ from typing import Any, Dict, List, Mapping, Sequence
 
 import pandas as pd
 
-from . import _campaign_frame, _campaign_source, _flags, _schuler, navigate, Campaign, NavResult
+from . import _campaign_frame, _campaign_source, _options, _schuler, navigate, Campaign, NavResult
 
 __all__ = ["montecarlo", "navigate_files"]
 
 
-def _run_seeds(seeds: List[int], source: Dict[str, Any], flags: List[str]) -> Dict[str, Any]:
+def _run_seeds(seeds: List[int], source: Dict[str, Any], options: Dict[str, Any]) -> Dict[str, Any]:
     """One task: the rows of ``seeds`` on one thread of the worker."""
-    return _schuler.montecarlo_seeds(seeds, flags=flags, threads=1, **source)
+    return _schuler.montecarlo_seeds(seeds, options=options, threads=1, **source)
 
 
 def montecarlo(
@@ -53,8 +53,8 @@ def montecarlo(
         raise ValueError("runs and per_task must be at least 1")
     seeds = [(seed + k) % 2**64 for k in range(runs)]
     chunks = [seeds[i : i + per_task] for i in range(0, runs, per_task)]
-    source, flags = _campaign_source(campaign, portable=True), _flags(options)
-    futures = client.map(_run_seeds, chunks, source=source, flags=flags)
+    source, opts = _campaign_source(campaign, portable=True), _options(options)
+    futures = client.map(_run_seeds, chunks, source=source, options=opts)
     parts = client.gather(futures)
     return pd.concat([_campaign_frame(p) for p in parts], ignore_index=True)
 
