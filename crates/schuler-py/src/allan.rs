@@ -94,6 +94,7 @@ pub fn allan_fit<'py>(
     imu_dt: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use schuler_run::allan as analysis;
+    crate::options::check_flag_names::<schuler_run::allan::Args>(&flags).py_err(py)?;
     let args = <AllanFlags as clap::Parser>::try_parse_from(&flags)
         .py_err(py)?
         .args;

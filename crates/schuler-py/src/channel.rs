@@ -45,6 +45,7 @@ struct ChannelFlags {
 /// text). The GIL is released while it runs.
 #[pyfunction]
 pub fn channel<'py>(py: Python<'py>, flags: Vec<String>) -> PyResult<Bound<'py, PyDict>> {
+    crate::options::check_flag_names::<Args>(&flags).py_err(py)?;
     let args = ChannelFlags::try_parse_from(&flags).py_err(py)?.args;
     let (cfg, run) = py
         .detach(|| -> anyhow::Result<_> {

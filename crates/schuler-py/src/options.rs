@@ -92,3 +92,19 @@ pub fn aiding_options(options: toml::Table) -> Result<AidingOptions> {
     }
     read_group(groups.pop().unwrap_or_default())
 }
+
+/// Checks that every `--name[=value]` of `flags` is an option of `A` (the commands
+/// whose Python functions still hand flags to clap: `channel`, `allan_fit`), so a
+/// misspelt keyword is refused as [`nav_description`]'s are, with the nearest name.
+pub fn check_flag_names<A: clap::Args>(flags: &[String]) -> Result<()> {
+    let known = keys_of::<A>();
+    for flag in flags {
+        if let Some(name) = flag.strip_prefix("--") {
+            let name = name.split('=').next().unwrap_or(name).replace('-', "_");
+            if !known.contains(&name) {
+                return Err(unknown_option(&name, &known));
+            }
+        }
+    }
+    Ok(())
+}

@@ -63,6 +63,11 @@ def test_options_are_the_cli_flags(drive):
         schuler.navigate(drive / "imu.txt", lever_arm=(1, 2), **START)
     with pytest.raises(TypeError, match="^option `lever_arm`: cannot pass a dict"):
         schuler.navigate(drive / "imu.txt", lever_arm={"x": 1}, **START)
+    # The textbook's channel and the Allan fit name a misspelt keyword the same way.
+    with pytest.raises(TypeError, match=r"^unknown option `gyro_drifts` \(did you mean `gyro_drift`\?\)$"):
+        schuler.channel(gyro_drifts="0.01deg/h")
+    with pytest.raises(TypeError, match=r"^unknown option `gyro_units` \(did you mean `gyro_unit`\?\)$"):
+        schuler.allan_fit(drive / "imu.txt", gyro_units="deg/s")
     with pytest.raises(schuler.SchulerError, match=r"init_pos: latitude 95"):
         schuler.navigate(drive / "imu.txt", init_pos=(95, 0, 0), init_att=(0, 0, 0))
     with pytest.raises(schuler.SchulerError, match="no initial attitude"):
