@@ -8,6 +8,7 @@
 mod hatanaka;
 pub mod nav;
 pub mod obs;
+pub mod raw;
 
 use crate::formats::InputError;
 use crate::formats::error::InputErrorKind;
