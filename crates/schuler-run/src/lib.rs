@@ -19,6 +19,7 @@ pub mod compare;
 pub mod demo;
 pub mod drive;
 pub mod flat_options;
+pub mod gnss;
 pub mod imu_input;
 pub mod interrupt;
 pub mod kf_gins;
