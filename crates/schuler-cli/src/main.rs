@@ -37,6 +37,9 @@ enum Command {
     Bag(schuler_cli::commands::bag::Args),
     /// Noise of a static IMU log: Allan deviations, IEEE 952 terms, nav's noise config.
     Allan(schuler_run::allan::Args),
+    /// Single-point positioning of a RINEX observation file with broadcast ephemerides:
+    /// nav.txt, nav.csv, an RTKLIB .pos and the satellites of every epoch.
+    Gnss(schuler_run::gnss::Args),
     /// Monte-Carlo campaign: N seeds of a scenario simulated, navigated and compared
     /// on every core; a table of one row per run and a report.
     Montecarlo(schuler_cli::commands::montecarlo::Args),
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => schuler_cli::commands::compare::run(args),
         Command::Allan(args) => schuler_cli::commands::allan::run(args),
         Command::Bag(args) => schuler_cli::commands::bag::run(args),
+        Command::Gnss(args) => schuler_cli::commands::gnss::run(args),
         Command::Montecarlo(args) => schuler_cli::commands::montecarlo::run(args),
     };
     match result {

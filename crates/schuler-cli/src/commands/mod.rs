@@ -7,6 +7,7 @@ pub mod bag;
 pub mod channel;
 pub mod compare;
 pub mod demo;
+pub mod gnss;
 pub mod kf_gins;
 pub mod montecarlo;
 pub mod nav;
