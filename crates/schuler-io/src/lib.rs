@@ -14,6 +14,7 @@ pub mod bag;
 pub mod fixed;
 pub mod formats;
 pub mod line_file;
+pub mod logs;
 pub mod named;
 pub mod output;
 pub mod text_block;
