@@ -19,6 +19,8 @@
 //!   tightly coupled filter takes a receiver's or a phone's measurements as it takes a
 //!   RINEX file's.
 
+pub mod gnss_logger;
+
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
 use schuler::filter::GnssFix;
