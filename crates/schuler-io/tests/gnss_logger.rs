@@ -374,6 +374,15 @@ fn garbled_lines_are_refused_with_file_line_field() {
     let f = good.split(',').nth(5).unwrap().to_owned();
     let e = error_of(&[good.replace(&f, "-1.38343575091027E+018")]);
     assert_eq!((e.line, e.field.as_deref()), (7, Some("FullBiasNanos")));
+    // Clocks beyond what sums of nanoseconds can hold.
+    let e = error_of(&[good.replace(",16431,", ",16431,-9223372036854775807,")]);
+    assert_eq!(e.kind, InputErrorKind::ColumnCount);
+    let tow = good.split(',').nth(14).unwrap().to_owned();
+    let e = error_of(&[good.replace(&format!(",{tow},"), ",-9223372036854775807,")]);
+    assert_eq!(
+        (e.kind, e.field.as_deref()),
+        (InputErrorKind::OutOfDomain, Some("ReceivedSvTimeNanos"))
+    );
     // A line cut short.
     let e = error_of(&[good.clone(), good[..good.len() - 20].to_owned()]);
     assert_eq!((e.kind, e.line), (InputErrorKind::ColumnCount, 8));

@@ -82,6 +82,23 @@ use std::sync::Arc;
 /// `√(−2 ln 0.32)`.
 const R68_OVER_SIGMA: f64 = 1.509_596_1;
 
+/// An integer field's admissible values.
+type Bounds = std::ops::RangeInclusive<i64>;
+/// Any value (a count only compared).
+const ANY: Bounds = i64::MIN..=i64::MAX;
+/// Nanosecond clocks (`TimeNanos`, `ReceivedSvTimeNanos`, `elapsedRealtimeNanos`):
+/// ±1e18 ns (31 years), so that sums of a few of them stay within `i64` (9.2e18).
+const CLOCK_NS: Bounds = -1_000_000_000_000_000_000..=1_000_000_000_000_000_000;
+/// `FullBiasNanos`: ±3e18 ns (GPS time reaches 3e18 ns in 2075).
+const FULL_BIAS_NS: Bounds = -3_000_000_000_000_000_000..=3_000_000_000_000_000_000;
+/// UNIX milliseconds up to 4e12 (year 2096), so that their GPS nanoseconds fit `i64`.
+const UNIX_MS: Bounds = 0..=4_000_000_000_000;
+/// Small counts and identifiers (`Svid`, `ConstellationType`, `LeapSecond`).
+const SMALL: Bounds = -1_000..=1_000;
+/// The largest `BiasNanos` or `TimeOffsetNanos` read [ns] (a second: a receiver's
+/// sub-nanosecond bias or offset, never near it).
+const MAX_SUB_NS: f64 = 1e9;
+
 /// What the reader skipped or met, for a report.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct GnssLoggerStats {
@@ -422,27 +439,52 @@ impl Parse<'_> {
             .ok_or_else(|| self.err(row, i, InputErrorKind::NotANumber, "empty".to_owned()))
     }
     /// An integer written as one (a count of nanoseconds written with an exponent has
-    /// lost its last digits to a spreadsheet's rounding, and is refused).
-    fn opt_i64(&self, row: &Row, i: usize) -> Result<Option<i64>, InputError> {
+    /// lost its last digits to a spreadsheet's rounding, and is refused) within
+    /// `range` (bounds that keep every sum of nanoseconds within `i64`).
+    fn opt_i64(&self, row: &Row, i: usize, range: Bounds) -> Result<Option<i64>, InputError> {
         let s = self.text(row, i);
         if s.is_empty() {
             return Ok(None);
         }
-        s.parse().map(Some).map_err(|_| {
+        let v: i64 = s.parse().map_err(|_| {
             self.err(
                 row,
                 i,
                 InputErrorKind::NotANumber,
                 format!("not an integer: {s:?} (a count written in full is needed; a spreadsheet's rounding loses digits)"),
             )
-        })
+        })?;
+        if !range.contains(&v) {
+            return Err(self.err(
+                row,
+                i,
+                InputErrorKind::OutOfDomain,
+                format!("{v} outside {}..={}", range.start(), range.end()),
+            ));
+        }
+        Ok(Some(v))
     }
-    fn i64(&self, row: &Row, i: usize) -> Result<i64, InputError> {
-        self.opt_i64(row, i)?
+    fn i64(&self, row: &Row, i: usize, range: Bounds) -> Result<i64, InputError> {
+        self.opt_i64(row, i, range)?
             .ok_or_else(|| self.err(row, i, InputErrorKind::NotANumber, "empty".to_owned()))
     }
+    /// A real number within ±`bound`.
+    fn f64_within(&self, row: &Row, i: usize, bound: f64) -> Result<Option<f64>, InputError> {
+        let v = self.opt_f64(row, i)?;
+        if let Some(x) = v
+            && x.abs() > bound
+        {
+            return Err(self.err(
+                row,
+                i,
+                InputErrorKind::OutOfDomain,
+                format!("{x} beyond ±{bound}"),
+            ));
+        }
+        Ok(v)
+    }
     fn u32(&self, row: &Row, i: usize) -> Result<u32, InputError> {
-        let v = self.i64(row, i)?;
+        let v = self.i64(row, i, ANY)?;
         u32::try_from(v).map_err(|_| {
             self.err(
                 row,
@@ -658,7 +700,7 @@ impl GnssLoggerReader {
 
     /// Seconds of the log's week of GPS time `gps_ns`.
     fn t_of(&self, gps_ns: i64) -> f64 {
-        (gps_ns - self.week * WEEK_NS) as f64 * 1e-9
+        (i128::from(gps_ns) - i128::from(self.week) * i128::from(WEEK_NS)) as f64 * 1e-9
     }
 
     fn push(&mut self, stream: usize, record: LogRecord) {
@@ -758,8 +800,8 @@ impl GnssLoggerReader {
             path: &self.path,
             header: names,
         };
-        let utc = p.i64(row, cols.utc)?;
-        let ern = cols.ern.map(|i| p.i64(row, i)).transpose()?;
+        let utc = p.i64(row, cols.utc, UNIX_MS)?;
+        let ern = cols.ern.map(|i| p.i64(row, i, CLOCK_NS)).transpose()?;
         let v = [
             p.f64(row, cols.xyz[0])?,
             p.f64(row, cols.xyz[1])?,
@@ -825,8 +867,8 @@ impl GnssLoggerReader {
             path: &self.path,
             header: &self.names["OrientationDeg"],
         };
-        let utc = p.i64(row, cols.utc)?;
-        let ern = cols.ern.map(|i| p.i64(row, i)).transpose()?;
+        let utc = p.i64(row, cols.utc, UNIX_MS)?;
+        let ern = cols.ern.map(|i| p.i64(row, i, CLOCK_NS)).transpose()?;
         let att = orientation_to_euler(
             p.f64(row, cols.yaw)?,
             p.f64(row, cols.pitch)?,
@@ -968,22 +1010,22 @@ fn parse_raw(
         path,
         header: &names["Raw"],
     };
-    let opt_i = |i: Option<usize>| {
-        i.map(|i| p.opt_i64(row, i))
+    let opt_i = |i: Option<usize>, b: Bounds| {
+        i.map(|i| p.opt_i64(row, i, b))
             .transpose()
             .map(Option::flatten)
     };
     Ok(RawRow {
-        time_nanos: p.i64(row, c.time_nanos)?,
-        full_bias_nanos: p.i64(row, c.full_bias)?,
-        bias_nanos: p.opt_f64(row, c.bias)?.unwrap_or(0.0),
-        time_offset_nanos: p.opt_f64(row, c.time_offset)?.unwrap_or(0.0),
-        leap_second: opt_i(c.leap)?,
-        discontinuity: opt_i(c.discontinuity)?,
-        svid: p.i64(row, c.svid)?,
-        constellation: p.i64(row, c.constellation)?,
+        time_nanos: p.i64(row, c.time_nanos, CLOCK_NS)?,
+        full_bias_nanos: p.i64(row, c.full_bias, FULL_BIAS_NS)?,
+        bias_nanos: p.f64_within(row, c.bias, MAX_SUB_NS)?.unwrap_or(0.0),
+        time_offset_nanos: p.f64_within(row, c.time_offset, MAX_SUB_NS)?.unwrap_or(0.0),
+        leap_second: opt_i(c.leap, SMALL)?,
+        discontinuity: opt_i(c.discontinuity, ANY)?,
+        svid: p.i64(row, c.svid, SMALL)?,
+        constellation: p.i64(row, c.constellation, SMALL)?,
         state: p.u32(row, c.state)?,
-        received_sv_time_nanos: p.i64(row, c.sv_time)?,
+        received_sv_time_nanos: p.i64(row, c.sv_time, CLOCK_NS)?,
         received_sv_time_uncertainty_nanos: p.f64(row, c.sv_time_unc)?,
         cn0: p.f64(row, c.cn0)?,
         pseudorange_rate: p.f64(row, c.prr)?,
@@ -996,7 +1038,7 @@ fn parse_raw(
             .code_type
             .and_then(|i| p.text(row, i).chars().next())
             .filter(char::is_ascii_alphabetic),
-        chipset_elapsed_realtime_nanos: opt_i(c.chipset)?,
+        chipset_elapsed_realtime_nanos: opt_i(c.chipset, CLOCK_NS)?,
     })
 }
 
@@ -1072,8 +1114,12 @@ fn parse_fix(
         }
         _ => None,
     };
-    let gps_ns = unix_ms_to_gps_ns(p.i64(row, c.time)?);
-    let ern = c.ern.map(|i| p.opt_i64(row, i)).transpose()?.flatten();
+    let gps_ns = unix_ms_to_gps_ns(p.i64(row, c.time, UNIX_MS)?);
+    let ern = c
+        .ern
+        .map(|i| p.opt_i64(row, i, CLOCK_NS))
+        .transpose()?
+        .flatten();
     Ok(Some(ParsedFix {
         fix: GnssFix {
             t: 0.0,
@@ -1106,7 +1152,10 @@ fn parse_stamp(
         path,
         header: &names[kind],
     };
-    Ok((p.i64(row, utc)?, ern.map(|i| p.i64(row, i)).transpose()?))
+    Ok((
+        p.i64(row, utc, UNIX_MS)?,
+        ern.map(|i| p.i64(row, i, CLOCK_NS)).transpose()?,
+    ))
 }
 
 impl Iterator for GnssLoggerReader {
