@@ -85,7 +85,6 @@ fn imu_payload(t_us: u64, dt_us: u32, gyro: [f32; 3], accel: [f32; 3]) -> Vec<u8
     p
 }
 
-#[allow(clippy::too_many_arguments)]
 fn gps_payload(t_us: u64, utc_us: u64, lat_e7: i32, lon_e7: i32, h_mm: i32, fix: u8) -> Vec<u8> {
     let mut p = t_us.to_le_bytes().to_vec();
     p.extend_from_slice(&utc_us.to_le_bytes());

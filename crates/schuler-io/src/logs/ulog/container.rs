@@ -105,14 +105,14 @@ impl<R: Read> Container<R> {
         self.pos
     }
 
-    /// The payload of the message [`Self::next`] returned last.
+    /// The payload of the message [`Self::next_frame`] returned last.
     pub fn payload(&self) -> &[u8] {
         &self.buf
     }
 
     /// The next message, `None` at a clean end of file. The flag bits message is
     /// taken in here and not returned.
-    pub fn next(&mut self) -> Result<Option<Frame>, InputError> {
+    pub fn next_frame(&mut self) -> Result<Option<Frame>, InputError> {
         loop {
             let section_end = self.appended.first().copied();
             if let Some(end) = section_end

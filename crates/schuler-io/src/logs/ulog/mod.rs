@@ -219,7 +219,7 @@ impl UlogReader {
 
     /// The pass ahead: the first GNSS message with a 3-D fix and a UTC time.
     fn find_tie(&mut self) -> Result<Option<GpsTie>, InputError> {
-        while let Some(frame) = self.c.next()? {
+        while let Some(frame) = self.c.next_frame()? {
             if let Some((_, Decoded::Gnss { us, utc_us, fix })) = self.message(frame)?
                 && fix.is_some()
                 && let Some(tie) = GpsTie::new(us, utc_us)
@@ -438,7 +438,9 @@ impl UlogReader {
             {
                 return Ok(Some(item));
             }
-            let Some(frame) = self.c.next()? else {
+            let next = self.c.next_frame()?;
+            self.report.appended_sections = self.c.appended_sections;
+            let Some(frame) = next else {
                 if !self.imu.decided {
                     self.decide_continuity(self.c.position())?;
                     continue;
