@@ -6,6 +6,7 @@ pub mod gnss_ins_sim;
 pub mod imu_model;
 pub mod jet;
 pub mod motion;
+pub mod raw_gnss;
 pub mod receivers;
 pub mod run;
 pub mod scenario;

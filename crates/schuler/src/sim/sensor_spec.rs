@@ -404,6 +404,8 @@ pub struct GnssSpec {
     /// Outliers: time and NED jump.
     #[serde(default)]
     pub outliers: Vec<GnssOutlierSpec>,
+    /// Raw observations (`[gnss.raw]`), simulated beside the fixes.
+    pub raw: Option<super::raw_gnss::spec::RawGnssSpec>,
 }
 
 /// A GNSS outlier as written.
