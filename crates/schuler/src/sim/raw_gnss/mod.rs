@@ -163,6 +163,13 @@ pub struct RawSimEpoch {
     pub sats: Vec<SatTruth>,
 }
 
+/// One satellite's draws of an epoch: its multipath state and, per signal, the
+/// code's and the rate's standard normals.
+type Draw = (Sat, f64, Vec<(f64, f64)>);
+
+/// A satellite above the mask: its ephemeris, state, elevation and azimuth [rad].
+type Seen<'a> = (Sat, &'a Ephemeris, crate::gnss::SatState, f64, f64);
+
 /// The antenna's state at a scenario time: ECEF position [m] and velocity [m/s].
 pub trait Antenna {
     /// The state at scenario time `t` [s], `None` outside the trajectory.
@@ -222,24 +229,20 @@ impl RawGnssSimulator {
         let bias = self.clock.bias;
         let rx = GpsTime::new(m.week, t_rx);
         let truth_t = rx.add_s(-bias);
-        // The draws of every satellite, whatever is seen.
-        let draws: Vec<(Sat, Vec<(f64, f64)>, f64)> = self
-            .multipath
-            .iter()
-            .map(|(&s, &mp)| (s, Vec::new(), mp))
-            .collect();
-        let draws: Vec<_> = draws
-            .into_iter()
-            .map(|(s, mut v, mp)| {
-                for _ in &m.signals {
-                    v.push((self.noise.normal(), self.noise.normal()));
-                }
-                (s, v, mp)
-            })
-            .collect();
+        // The draws of every satellite, whatever is seen: per signal, the code's
+        // and the rate's standard normals; the multipath's state.
+        let mut draws: Vec<Draw> = Vec::with_capacity(self.multipath.len());
+        for (&s, &mp) in &self.multipath {
+            let v = m
+                .signals
+                .iter()
+                .map(|_| (self.noise.normal(), self.noise.normal()))
+                .collect();
+            draws.push((s, mp, v));
+        }
         let (r_ant, v_ant) = antenna.at(t_rx - bias)?;
         let geo = Wgs84.ecef_to_geodetic(&r_ant);
-        let mut seen: Vec<(Sat, &Ephemeris, crate::gnss::SatState, f64, f64)> = Vec::new();
+        let mut seen: Vec<Seen<'_>> = Vec::new();
         for (sat, _, _) in &draws {
             let Some(eph) = self.store.select(*sat, rx) else {
                 continue;
@@ -254,7 +257,7 @@ impl RawGnssSimulator {
         let mut measurements = Vec::new();
         let mut sats = Vec::new();
         for (sat, eph, state, el, az) in seen {
-            let (_, noise, mp) = draws.iter().find(|d| d.0 == sat).expect("drawn");
+            let (_, mp, noise) = draws.iter().find(|d| d.0 == sat).expect("drawn");
             let d = state.r_e - r_ant;
             let range = d.norm();
             let u = d / range;
@@ -362,11 +365,7 @@ impl RawGnssSimulator {
 
     /// Keeps, inside a window, only what it lets through (the first window holding
     /// `t_rx` decides).
-    fn apply_windows<T>(
-        &self,
-        t_rx: f64,
-        seen: &mut Vec<(Sat, T, crate::gnss::SatState, f64, f64)>,
-    ) {
+    fn apply_windows(&self, t_rx: f64, seen: &mut Vec<Seen<'_>>) {
         let Some(w) = self
             .model
             .windows
@@ -380,7 +379,7 @@ impl RawGnssSimulator {
                 // Highest first; equal elevations by satellite, for determinism.
                 seen.sort_by(|a, b| b.3.total_cmp(&a.3).then(a.0.cmp(&b.0)));
                 seen.truncate(*n);
-                seen.sort_by(|a, b| a.0.cmp(&b.0));
+                seen.sort_by_key(|s| s.0);
             }
             Keep::Listed(list) => seen.retain(|s| list.contains(&s.0)),
         }
