@@ -49,7 +49,7 @@ fn opt(v: Option<f64>) -> String {
 fn dump(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let mut reader = UbxReader::open(path)?;
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    for item in reader.by_ref() {
+    while let Some(item) = reader.next() {
         let item = item?;
         match &item.record {
             LogRecord::Gnss(f) => {

@@ -517,7 +517,7 @@ impl UbxReader {
                 );
             }
             (0x10, 0x03) => {
-                if p.len() < 4 || (p.len() - 4) % 8 != 0 {
+                if p.len() < 4 || !(p.len() - 4).is_multiple_of(8) {
                     return Err(self.error(
                         offset,
                         "ESF-RAW",
@@ -625,12 +625,13 @@ impl Iterator for UbxReader {
     type Item = Result<LogItem, InputError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        if !self.front_ready() && !self.done {
-            if let Err(e) = self.advance() {
-                self.done = true;
-                self.held.clear();
-                return Some(Err(e));
-            }
+        if !self.front_ready()
+            && !self.done
+            && let Err(e) = self.advance()
+        {
+            self.done = true;
+            self.held.clear();
+            return Some(Err(e));
         }
         match self.held.pop_front()? {
             Held::Ready(item) => Some(Ok(item)),
