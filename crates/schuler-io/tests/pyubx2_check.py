@@ -216,6 +216,12 @@ def compare(path, dump):
             want = sum(v for k, v in their_counts.items() if k[:1] == b"\x04")
         else:
             want = sum(v for k, v in their_counts.items() if UBX_MSGIDS.get(k) == name)
+        if name == "NMEA":
+            # A sentence torn by a serial dropout and followed by a whole one on the
+            # same line: pyubx2 drops both, schuler skips to the next `$` and keeps the
+            # whole one (f9p_rover_rawx_sfrbx: one such line). Ours may exceed by 1 %.
+            if want is not None and want <= n <= want + max(1, want // 100):
+                continue
         if want != n:
             errors.append(f"count of {name}: ours {n}, pyubx2 {want}")
     return errors
