@@ -264,6 +264,213 @@ pub const PITCH: Domain = Domain {
     why: "a pitch angle",
 };
 
+/// A time or a time offset [s] (a stamp, a shift between clocks): within three
+/// centuries of its epoch (Unix, GPS or the log's start). At 1e10 s an f64 still
+/// resolves 2 µs, a 10-kHz IMU's step a fiftieth; beyond, consecutive samples
+/// collapse onto the same time.
+pub const TIME: Domain = Domain {
+    quantity: "time",
+    min: -1e10,
+    max: 1e10,
+    unit: "s",
+    scale: 1.0,
+    why: "within three centuries of its epoch",
+};
+
+/// An IMU's sample rate [Hz]: at least one sample per [`IMU_INTERVAL`]'s longest step,
+/// at most 10 kHz (navigation and tactical IMUs deliver 100 Hz to 2 kHz, the fastest
+/// MEMS parts' output data rates end near 8 kHz). Beyond, a simulated or recorded
+/// stream is gigabytes a minute and no strapdown step resolves anything more.
+pub const IMU_RATE: Domain = Domain {
+    quantity: "IMU sample rate",
+    min: 1.0 / 60.0,
+    max: 1e4,
+    unit: "Hz",
+    scale: 1.0,
+    why: "one sample a minute to 10 kHz",
+};
+
+/// A GNSS receiver's fix rate [Hz]: positive, at most 100 Hz (the fastest survey and
+/// automotive receivers output 20 to 100 Hz; the tracking loops update at 1 kHz, but
+/// no receiver delivers positions that fast).
+pub const GNSS_RATE: Domain = Domain {
+    quantity: "GNSS fix rate",
+    min: f64::MIN_POSITIVE,
+    max: 100.0,
+    unit: "Hz",
+    scale: 1.0,
+    why: "positive, at most 100 Hz, the fastest receivers' output",
+};
+
+/// An aiding sensor's reading rate [Hz] (barometer, odometer, heading): positive, at
+/// most 1 kHz (barometers sample at 1 to 200 Hz, wheel encoders' speeds at up to a
+/// few hundred).
+pub const AID_RATE: Domain = Domain {
+    quantity: "reading rate",
+    min: f64::MIN_POSITIVE,
+    max: 1e3,
+    unit: "Hz",
+    scale: 1.0,
+    why: "positive, at most 1 kHz",
+};
+
+/// A standard deviation of an angular rate [rad/s] (a zero-rate update's noise, a gyro
+/// bias's prior): positive, at most [`ANGULAR_RATE`]'s bound.
+pub const ANGULAR_RATE_STD: Domain = Domain {
+    quantity: "angular rate standard deviation",
+    min: f64::MIN_POSITIVE,
+    ..ANGULAR_RATE
+};
+
+/// A standard deviation of a specific force [m/s²] (an accelerometer bias's prior):
+/// positive, at most [`SPECIFIC_FORCE`]'s bound.
+pub const SPECIFIC_FORCE_STD: Domain = Domain {
+    quantity: "specific force standard deviation",
+    min: f64::MIN_POSITIVE,
+    ..SPECIFIC_FORCE
+};
+
+/// An angle random walk [rad/√s] (a gyro's white noise density): zero (a perfect gyro)
+/// up to a noise of the gyro's whole range over one second.
+pub const ANGLE_RANDOM_WALK: Domain = Domain {
+    quantity: "angle random walk",
+    min: 0.0,
+    max: ANGULAR_RATE.max,
+    unit: "deg/sqrt(h)",
+    scale: DEG / 60.0,
+    why: "at most the gyro's range over one second",
+};
+
+/// A velocity random walk [m/s/√s] (an accelerometer's white noise density): zero up
+/// to a noise of the accelerometer's whole range over one second.
+pub const VELOCITY_RANDOM_WALK: Domain = Domain {
+    quantity: "velocity random walk",
+    min: 0.0,
+    max: SPECIFIC_FORCE.max,
+    unit: "m/s/sqrt(s)",
+    scale: 1.0,
+    why: "at most the accelerometer's range over one second",
+};
+
+/// A rate random walk [rad/s/√s] (a gyro bias's random walk or instability per
+/// √s): zero up to the gyro's whole range reached within one second.
+pub const RATE_RANDOM_WALK: Domain = Domain {
+    quantity: "rate random walk",
+    min: 0.0,
+    max: ANGULAR_RATE.max,
+    unit: "deg/s/sqrt(s)",
+    scale: DEG,
+    why: "at most the gyro's range within one second",
+};
+
+/// An acceleration random walk [m/s²/√s] (an accelerometer bias's random walk): zero
+/// up to the accelerometer's whole range reached within one second.
+pub const ACCELERATION_RANDOM_WALK: Domain = Domain {
+    quantity: "acceleration random walk",
+    min: 0.0,
+    max: SPECIFIC_FORCE.max,
+    unit: "m/s^2/sqrt(s)",
+    scale: 1.0,
+    why: "at most the accelerometer's range within one second",
+};
+
+/// A correlation time of a Gauss-Markov process [s] (a bias instability's): at least
+/// one second, since a bias correlated over less is the white noise the random walks
+/// (ARW, VRW) already model and its discrete process noise `2 sigma^2 / tau`
+/// overflows as `tau` goes to 0; at most a century (beyond, the process is a random
+/// walk over any run).
+pub const CORRELATION_TIME: Domain = Domain {
+    quantity: "correlation time",
+    min: 1.0,
+    max: 3.2e9,
+    unit: "s",
+    scale: 1.0,
+    why: "one second to a century",
+};
+
+/// A count given by a user ("how many": runs, threads, samples in a row) with its
+/// bounds: the one rule every count option goes through, so none reaches an
+/// allocation or a thread pool unbounded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Count {
+    /// What is counted ("runs").
+    pub quantity: &'static str,
+    /// Fewest allowed.
+    pub min: u64,
+    /// Most allowed.
+    pub max: u64,
+    /// Why the bound is where it is.
+    pub why: &'static str,
+}
+
+/// A count outside its [`Count`] bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CountError {
+    /// The bounds that refused it.
+    pub count: Count,
+    /// The count read.
+    pub value: u64,
+}
+
+impl fmt::Display for CountError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let c = &self.count;
+        write!(
+            f,
+            "{} {} is outside [{}, {}] ({})",
+            c.quantity, self.value, c.min, c.max, c.why
+        )
+    }
+}
+
+impl std::error::Error for CountError {}
+
+impl Count {
+    /// `value` if it is within `[min, max]`.
+    pub fn check(&self, value: u64) -> Result<u64, CountError> {
+        if (self.min..=self.max).contains(&value) {
+            Ok(value)
+        } else {
+            Err(CountError {
+                count: *self,
+                value,
+            })
+        }
+    }
+}
+
+/// The bound of every count of repetitions or samples a user asks for: 10 000. A
+/// Monte-Carlo campaign of that many runs estimates a standard deviation to 0.7 %
+/// (`1/sqrt(2N)`), past any use; what each repetition keeps (a run's row and NEES
+/// series, tens of kB) then stays within hundreds of MB.
+pub const COUNT_MAX: u64 = 10_000;
+
+/// Monte-Carlo runs: 1 to [`COUNT_MAX`].
+pub const RUNS: Count = Count {
+    quantity: "number of runs",
+    min: 1,
+    max: COUNT_MAX,
+    why: "at least one; 10 000 runs estimate a standard deviation to 0.7 %",
+};
+
+/// Consecutive readings (a detector's streak to reacquire): 1 to [`COUNT_MAX`].
+pub const IN_A_ROW: Count = Count {
+    quantity: "readings in a row",
+    min: 1,
+    max: COUNT_MAX,
+    why: "at least one, at most 10 000",
+};
+
+/// Worker threads: 1 to 1024. The work is CPU-bound, so threads beyond the cores
+/// only share them; 1024 is above any single machine's core count, and each thread
+/// reserves its stack.
+pub const THREADS: Count = Count {
+    quantity: "number of threads",
+    min: 1,
+    max: 1024,
+    why: "at least one; more threads than cores only share them",
+};
+
 /// Longitude [rad] checked by [`LONGITUDE`] and wrapped into (-π, π].
 pub fn wrap_longitude(lon: f64) -> Result<f64, DomainError> {
     let lon = LONGITUDE.check(lon)?;
@@ -300,6 +507,24 @@ mod tests {
                 .contains("deg/s is outside [0, 20000] deg/s"),
             "{rate}"
         );
+    }
+
+    #[test]
+    fn counts_and_rates_are_bounded() {
+        assert_eq!(RUNS.check(1), Ok(1));
+        let e = RUNS.check(4_294_967_296).expect_err("2^32 runs");
+        assert!(
+            e.to_string()
+                .starts_with("number of runs 4294967296 is outside [1, 10000]"),
+            "{e}"
+        );
+        assert!(RUNS.check(0).is_err());
+        assert!(THREADS.check(99_999_999_999).is_err());
+        assert!(IMU_RATE.check(1e6).is_err());
+        assert!(GNSS_RATE.check(1e308).is_err());
+        assert!(GNSS_RATE.check(0.0).is_err());
+        assert!(CORRELATION_TIME.check(1e-30).is_err());
+        assert!(ANGULAR_RATE_STD.check(0.0).is_err());
     }
 
     #[test]
