@@ -99,12 +99,16 @@ where
     use schuler::align::in_motion::{
         InMotionConfig, VELOCITY_SPAN, course_pair, start_at_fix, start_in_motion,
     };
+    let name = clap::ValueEnum::to_possible_value(&init)
+        .map_or_else(|| format!("{init:?}"), |v| v.get_name().to_owned());
     let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
-        bail!("--init {init:?} needs GNSS fixes (--gnss FILE)");
+        bail!("--init {name} needs GNSS fixes (--gnss FILE)");
     };
     let all = aiding.fixes.to_vec()?;
     let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &all);
-    let context = || format!("--init gnss: {}", settings.imu.display());
+    // The start's failures are the fixes' (their number, order, values), not the IMU
+    // file's: the messages say so.
+    let context = || format!("--init {name}");
     let first = match reader.next() {
         Some(s) => s?,
         None => bail!(
@@ -115,10 +119,17 @@ where
     let i0 = fixes.partition_point(|f| f.t < first.t);
     let j = match init {
         InitChoice::Gnss => course_pair(&earth, fixes, &cfg).with_context(context)?.1,
-        _ => i0 + fixes[i0..].partition_point(|f| f.t < first.t + VELOCITY_SPAN),
+        // A fix before it to difference the velocity with (the next one at least).
+        _ => (i0 + fixes[i0..].partition_point(|f| f.t < first.t + VELOCITY_SPAN)).max(i0 + 1),
     };
     let Some(fix) = fixes.get(j) else {
-        bail!("{}: no GNSS fix two seconds into the IMU data", context());
+        bail!(
+            "{}: {} GNSS fix(es), none two seconds into the IMU data (t = {} s on) after \
+             another",
+            context(),
+            fixes.len(),
+            first.t
+        );
     };
     let mut samples = vec![first];
     let until = fix.t + cfg.settle + cfg.level_window;

@@ -111,6 +111,32 @@ pub enum InMotionError {
         /// Its standard deviation [m].
         std: f64,
     },
+    /// Fewer than two fixes, or none after the start's first in time.
+    #[error(
+        "a start in motion needs two GNSS fixes at increasing times, the later at least \
+         {span} s into the IMU data; {why}"
+    )]
+    TooFewFixes {
+        /// Time the fixes are differenced over [s] ([`VELOCITY_SPAN`]).
+        span: f64,
+        /// What was found instead.
+        why: String,
+    },
+    /// The fixes imply a motion no vehicle makes (a velocity beyond
+    /// [`crate::domain::SPEED`], or an acceleration beyond `g` that leaves no tilt to
+    /// take from the accelerometers).
+    #[error(
+        "the GNSS fixes from t = {t0} s to t = {t1} s imply {what}: fixes swapped or \
+         misread (latitude and longitude exchanged, a column off)?"
+    )]
+    ImplausibleFixes {
+        /// The earlier fix's time [s].
+        t0: f64,
+        /// The later fix's time [s].
+        t1: f64,
+        /// What they imply.
+        what: String,
+    },
     /// The IMU samples do not cover the start.
     #[error("no IMU samples around t = {t} s, the middle of the fixes that start the run")]
     NoSamples {
@@ -144,7 +170,13 @@ pub fn course_pair<E: EarthModel>(
     fixes: &[GnssFix],
     cfg: &InMotionConfig,
 ) -> Result<(usize, usize), InMotionError> {
-    let (mut best, mut best_std) = (0.0f64, f64::NAN);
+    if fixes.len() < 2 {
+        return Err(InMotionError::TooFewFixes {
+            span: VELOCITY_SPAN,
+            why: format!("{} given", fixes.len()),
+        });
+    }
+    let (mut best, mut best_std) = (0.0f64, None);
     for j in 1..fixes.len() {
         for i in (0..j).rev() {
             if fixes[j].t - fixes[i].t > cfg.max_interval {
@@ -157,17 +189,27 @@ pub fn course_pair<E: EarthModel>(
             if d >= cfg.displacement_sigmas * std {
                 return Ok((i, j));
             }
-            if d > best {
-                (best, best_std) = (d, std);
+            if best_std.is_none() || d > best {
+                (best, best_std) = (d, Some(std));
             }
         }
     }
-    Err(InMotionError::NoMotion {
-        sigmas: cfg.displacement_sigmas,
-        max_interval: cfg.max_interval,
-        best,
-        std: best_std,
-    })
+    match best_std {
+        Some(std) => Err(InMotionError::NoMotion {
+            sigmas: cfg.displacement_sigmas,
+            max_interval: cfg.max_interval,
+            best,
+            std,
+        }),
+        None => Err(InMotionError::TooFewFixes {
+            span: VELOCITY_SPAN,
+            why: format!(
+                "no two of the {} fixes are within {} s of each other in time order",
+                fixes.len(),
+                cfg.max_interval
+            ),
+        }),
+    }
 }
 
 /// The angle the gyros turned about the body's z axis between `t0` and `t1` [rad].
@@ -344,7 +386,34 @@ pub fn start_at_fix<E: EarthModel>(
     j: usize,
     cfg: &InMotionConfig,
 ) -> Result<InMotionStart, InMotionError> {
-    let b = &fixes[j];
+    // The velocity is differenced between fixes i..=j: two distinct fixes at least,
+    // their times increasing (a log in reverse order has none after its first).
+    let pair = fixes
+        .get(i)
+        .zip(fixes.get(j))
+        .filter(|(a, b)| j > i && b.t > a.t);
+    let Some((a, b)) = pair else {
+        return Err(InMotionError::TooFewFixes {
+            span: VELOCITY_SPAN,
+            why: match fixes.get(i) {
+                Some(a) => format!("no fix after the one at t = {} s", a.t),
+                None => format!(
+                    "{} fixes, none at or after the IMU data's start",
+                    fixes.len()
+                ),
+            },
+        });
+    };
+    if let Some(k) = (i..j).find(|&k| fixes[k + 1].t <= fixes[k].t) {
+        return Err(InMotionError::TooFewFixes {
+            span: VELOCITY_SPAN,
+            why: format!(
+                "the fix after t = {} s is at t = {} s (the log not in time order)",
+                fixes[k].t,
+                fixes[k + 1].t
+            ),
+        });
+    }
     let sample = sample_near(samples, b.t).ok_or(InMotionError::NoSamples { t: b.t })?;
     let t_s = samples[sample].t;
     let (v_n, sigma_v) = velocity_at(earth, fixes, i, j, VELOCITY_SPAN);
@@ -365,6 +434,27 @@ pub fn start_at_fix<E: EarthModel>(
     // The tilts' error is the horizontal acceleration at the start over g: of the
     // order of the change between the last two velocities.
     let accel = (v_n - v_before).xy().norm() / VELOCITY_SPAN + 2.0 * sigma_v / VELOCITY_SPAN;
+    let implausible = |what: String| InMotionError::ImplausibleFixes {
+        t0: a.t,
+        t1: b.t,
+        what,
+    };
+    if crate::domain::SPEED.check(v_n.norm()).is_err() {
+        return Err(implausible(format!(
+            "a speed of {:.0} m/s (beyond {} m/s, the escape velocity)",
+            v_n.norm(),
+            crate::domain::SPEED.max
+        )));
+    }
+    // The tilts are the specific force's direction taken as gravity's: with the
+    // acceleration near g they are unknown (a standard deviation beyond 45 deg).
+    if !(accel < local.g_n.z) {
+        return Err(implausible(format!(
+            "an acceleration of {:.1} m/s^2 with a velocity uncertain by {sigma_v:.1} m/s \
+             (together more than g: no tilt can be taken from the accelerometers)",
+            (v_n - v_before).xy().norm() / VELOCITY_SPAN
+        )));
+    }
     let half = 0.5 * cfg.level_window;
     let (sum_dv, sum_dt) = samples
         .iter()
