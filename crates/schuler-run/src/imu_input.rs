@@ -149,12 +149,9 @@ impl ImuInputOptions {
     /// The reader's options, with the time window `t_start`, `t_end`; each value
     /// checked, errors naming the flag.
     pub fn read_options(&self, t_start: Option<f64>, t_end: Option<f64>) -> Result<ImuReadOptions> {
-        let imu_rate = rate("imu-rate", self.imu_rate)?;
-        if let Some(s) = self.imu_time_offset
-            && !s.is_finite()
-        {
-            bail!("--imu-time-offset must be a finite number of seconds, got {s}");
-        }
+        let imu_rate = rate("imu-rate", &schuler::domain::IMU_RATE, self.imu_rate)?;
+        let offset = self.imu_time_offset;
+        crate::options::opt_in_domain("--imu-time-offset", &schuler::domain::TIME, offset)?;
         let columns = match &self.imu_columns {
             Some(text) => Some(
                 ColumnSpec::parse(text)

@@ -230,14 +230,15 @@ pub fn opt_in_domain(
     value.map(|x| in_domain(key, domain, x)).transpose()
 }
 
-/// A rate flag [Hz], checked positive.
-pub fn rate(flag: &str, r: Option<f64>) -> Result<Option<f64>> {
-    if let Some(r) = r
-        && !(r.is_finite() && r > 0.0)
-    {
-        bail!("--{flag} must be a positive number of Hz, got {r}");
-    }
-    Ok(r)
+/// A count of a flag or key `key` within `count` (the bounded-count rule of
+/// [`schuler::domain::Count`]); else the error naming the key.
+pub fn in_count(key: &str, count: &schuler::domain::Count, value: u64) -> Result<u64> {
+    count.check(value).with_context(|| key.to_owned())
+}
+
+/// A rate flag [Hz] within `domain` (an IMU's or an aid's rate, [`schuler::domain`]).
+pub fn rate(flag: &str, domain: &schuler::domain::Domain, r: Option<f64>) -> Result<Option<f64>> {
+    opt_in_domain(&format!("--{flag}"), domain, r)
 }
 
 /// The value of an aiding option given with a unit (or as a bare SI number), checked
@@ -253,6 +254,23 @@ pub fn quantity(
         bail!("--{flag} must not be negative, got {s:?}");
     }
     Ok(Some(x))
+}
+
+/// [`quantity`] within `domain` (its physical range, [`schuler::domain`]); errors name
+/// the flag.
+pub fn quantity_in(
+    flag: &str,
+    v: &Option<String>,
+    dim: schuler::units::Dimension,
+    domain: &schuler::domain::Domain,
+) -> Result<Option<f64>> {
+    opt_in_domain(&format!("--{flag}"), domain, quantity(flag, v, dim)?)
+}
+
+/// `domain` with zero allowed: a noise model's standard deviation or density may be
+/// zero (a perfect sensor), a measurement's may not.
+pub const fn or_zero(domain: schuler::domain::Domain) -> schuler::domain::Domain {
+    schuler::domain::Domain { min: 0.0, ..domain }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -303,6 +321,29 @@ pub fn is_positive(x: f64) -> bool {
     x > 0.0
 }
 
+/// A sphere's radius [m]: a kilometre (a small asteroid) to a million kilometres (beyond
+/// the Sun's 696 000 km); with [`SURFACE_GRAVITY`] its `μ = g a²` stays a positive
+/// finite number (a radius of 1e-300 m made it 0).
+const SPHERE_RADIUS: schuler::domain::Domain = schuler::domain::Domain {
+    quantity: "sphere radius",
+    min: 1e3,
+    max: 1e9,
+    unit: "m",
+    scale: 1.0,
+    why: "an asteroid's to beyond the Sun's",
+};
+
+/// Gravitation at a sphere's surface [m/s²]: positive, at most 1000 m/s² (the Sun's
+/// surface has 274).
+const SURFACE_GRAVITY: schuler::domain::Domain = schuler::domain::Domain {
+    quantity: "surface gravitation",
+    min: 1e-6,
+    max: 1e3,
+    unit: "m/s^2",
+    scale: 1.0,
+    why: "positive, at most 1000 m/s^2",
+};
+
 /// The textbook sphere's radius and surface gravitation (`schuler channel`, `schuler vertical`).
 #[derive(clap::Args, Debug, Clone, Copy)]
 pub struct SphereArgs {
@@ -317,12 +358,8 @@ pub struct SphereArgs {
 impl SphereArgs {
     /// The sphere rotating at `rate`, after checking both values are positive.
     pub fn sphere(&self, rate: f64) -> Result<Sphere> {
-        if !is_positive(self.radius) {
-            bail!("--radius must be positive, got {} m", self.radius);
-        }
-        if !is_positive(self.g) {
-            bail!("--g must be positive, got {} m/s^2", self.g);
-        }
+        in_domain("--radius", &SPHERE_RADIUS, self.radius)?;
+        in_domain("--g", &SURFACE_GRAVITY, self.g)?;
         Ok(Sphere::with_surface_gravity(self.radius, self.g, rate))
     }
 }

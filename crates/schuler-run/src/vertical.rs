@@ -208,9 +208,8 @@ pub fn run_and_write(args: &Args) -> Result<Value> {
     if !is_positive(args.gate) {
         bail!("--gate must be positive, got {} m", args.gate);
     }
-    if args.reacquire == 0 {
-        bail!("--reacquire must be at least 1");
-    }
+    let n = args.reacquire as u64;
+    crate::options::in_count("--reacquire", &schuler::domain::IN_A_ROW, n)?;
     let cfg = VerticalConfig {
         earth: args.sphere.sphere(0.0)?,
         height: args.height,

@@ -1,7 +1,7 @@
 //! `schuler montecarlo`: a campaign ([`schuler_run::campaign`]) of `--runs` seeds from
 //! `--seed` on every core, its table, summary and report written into `--out`.
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use schuler_run::campaign::{self, CampaignConfig, aggregate::Aggregate};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -30,12 +30,7 @@ pub struct Args {
 
 /// Runs the campaign and writes its files.
 pub fn run(args: Args) -> Result<()> {
-    if args.runs == 0 {
-        bail!("--runs must be at least 1");
-    }
-    if args.threads == Some(0) {
-        bail!("--threads must be at least 1");
-    }
+    campaign::check_counts(args.runs, args.threads)?;
     let config = CampaignConfig::load(&args.config)?;
     let started = Instant::now();
     let results = campaign::run(&config, args.runs, args.seed, args.threads)?;
@@ -54,8 +49,13 @@ pub fn run(args: Args) -> Result<()> {
         "horizontal_max_m",
         "outage_horizontal_max_m",
     ] {
-        if let Some(c) = aggregate.column(name).filter(|c| c.count > 0) {
-            println!("  {name:<24} mean {:.4}  std {:.4}", c.mean, c.std);
+        match aggregate.column(name) {
+            // A standard deviation needs two runs.
+            Some(c) if c.count > 1 => {
+                println!("  {name:<24} mean {:.4}  std {:.4}", c.mean, c.std);
+            }
+            Some(c) if c.count == 1 => println!("  {name:<24} {:.4} (one run)", c.mean),
+            _ => {}
         }
     }
     if let Some(n) = &aggregate.nees {

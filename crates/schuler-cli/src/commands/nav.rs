@@ -173,7 +173,7 @@ fn print_aided(
 ) -> Result<()> {
     let c = summary.nav.counts;
     println!(
-        "integrated {} samples with {} GNSS fixes in {:.2} s: {} position and {} velocity updates, {} rejected by the gate, {} outside the IMU data (see rejected.csv); mean NIS per dimension {:.2}",
+        "integrated {} samples with {} GNSS fixes in {:.2} s: {} position and {} velocity updates, {} rejected by the gate, {} outside the IMU data (see rejected.csv); mean NIS per dimension {}",
         summary.nav.samples,
         aiding.fixes.len(),
         secs,
@@ -181,7 +181,7 @@ fn print_aided(
         c.velocity,
         c.rejected,
         c.skipped,
-        summary.nav.mean_nis_per_dof
+        mean_nis_text(summary.nav.mean_nis_per_dof)
     );
     print_handovers(&summary.nav);
     print!("{}", summary.report_text);
@@ -235,13 +235,41 @@ fn print_aided(
         );
     }
     if c.rejected * 10 > tried {
-        eprintln!(
-            "warning: the gate refused {} of {} measurements (see rejected.csv): the IMU noise model is probably too optimistic for this sensor (--imu-grade, --arw, --gyro-bias-std, ...)",
-            c.rejected, tried
-        );
+        print_gate_warning(&settings.out, c.rejected, tried);
     }
     println!("{wrote}");
     Ok(())
+}
+
+/// The warning of a gate that refused many measurements: which kinds it refused and
+/// their likely causes (`rejected.csv` says which).
+fn print_gate_warning(out: &std::path::Path, rejected: u64, tried: u64) {
+    use schuler_run::aided::refusals::{by_kind, likely_causes};
+    let kinds = by_kind(out);
+    let Some((kind, n)) = kinds.first() else {
+        eprintln!(
+            "warning: the gate refused {rejected} of {tried} measurements: a measurement \
+             misread or its noise too small, or the IMU noise model too optimistic \
+             (--imu-grade, --arw, --gyro-bias-std, ...)"
+        );
+        return;
+    };
+    let all: Vec<String> = kinds.iter().map(|(k, n)| format!("{n} {k}")).collect();
+    eprintln!(
+        "warning: the gate refused {rejected} of {tried} measurements ({}; see \
+         rejected.csv); for the {n} {kind} refused: {}",
+        all.join(", "),
+        likely_causes(kind)
+    );
+}
+
+/// The mean NIS per dimension as printed: none when no update was accepted.
+fn mean_nis_text(nis: f64) -> String {
+    if nis.is_finite() {
+        format!("{nis:.2}")
+    } else {
+        "none (no update accepted)".to_owned()
+    }
 }
 
 /// Mean NIS per dimension beyond which, with most measurements refused, a run is

@@ -7,15 +7,17 @@
 pub mod feed;
 pub mod fixes;
 pub mod record;
+pub mod refusals;
 pub mod report;
 pub mod series;
 pub mod spilled;
 pub mod vehicle;
 
-use crate::options::{Triple, quantity};
+use crate::options::{Triple, or_zero, quantity, quantity_in};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use report::ReportSettings;
+use schuler::domain as d;
 use schuler::filter::{GnssFix, ImuNoise, IntegrationConfig, SensorEstimates};
 use schuler::session::{ErrorModelChoice, FilterConfig};
 use schuler::units::{Dimension, parse_as_or_si};
@@ -454,6 +456,23 @@ impl AidingOptions {
         self
     }
 
+    /// The input files given, each with its key (`gnss`, `baro`, ...).
+    pub fn input_files(&self) -> Vec<(&'static str, &Path)> {
+        [
+            ("gnss", &self.gnss),
+            ("gnss_vel", &self.gnss_vel),
+            ("truth", &self.truth),
+            ("sensor_truth", &self.sensor_truth),
+            ("baro", &self.baro),
+            ("zupt", &self.zupt),
+            ("odometer", &self.odometer),
+            ("dual_antenna", &self.dual_antenna),
+        ]
+        .into_iter()
+        .filter_map(|(k, p)| Some((k, p.as_deref()?)))
+        .collect()
+    }
+
     /// Whether any aiding source is given (GNSS, barometer or a vehicle aid).
     pub fn any(&self) -> bool {
         self.gnss.is_some()
@@ -584,12 +603,9 @@ impl AidingOptions {
 
     /// `--gnss-vel-std` [m/s] (0.1 when not given), which must be positive.
     fn gnss_vel_std(&self) -> Result<f64> {
-        let vel_std =
-            quantity("gnss-vel-std", &self.gnss_vel_std, Dimension::Velocity)?.unwrap_or(0.1);
-        if vel_std <= 0.0 {
-            bail!("--gnss-vel-std must be positive");
-        }
-        Ok(vel_std)
+        let (std, dim) = (&self.gnss_vel_std, Dimension::Velocity);
+        let vel_std = quantity_in("gnss-vel-std", std, dim, &d::VELOCITY_STD)?;
+        Ok(vel_std.unwrap_or(0.1))
     }
 
     /// `--gnss-time-offset` [s], which must be finite.
@@ -645,7 +661,7 @@ impl AidingOptions {
     /// The IMU noise model with the flags' overrides: white noise, bias and scale
     /// priors, then [`AidingOptions::bias_walks`].
     fn noise(&self, mut noise: ImuNoise) -> Result<ImuNoise> {
-        let q = quantity;
+        let q = quantity_in;
         let set = |v: &mut Vector3<f64>, x: Option<f64>| {
             if let Some(x) = x {
                 *v = Vector3::repeat(x);
@@ -653,15 +669,30 @@ impl AidingOptions {
         };
         set(
             &mut noise.arw,
-            q("arw", &self.arw, Dimension::AngleRandomWalk)?,
+            q(
+                "arw",
+                &self.arw,
+                Dimension::AngleRandomWalk,
+                &d::ANGLE_RANDOM_WALK,
+            )?,
         );
         set(
             &mut noise.vrw,
-            q("vrw", &self.vrw, Dimension::VelocityRandomWalk)?,
+            q(
+                "vrw",
+                &self.vrw,
+                Dimension::VelocityRandomWalk,
+                &d::VELOCITY_RANDOM_WALK,
+            )?,
         );
         set(
             &mut noise.gyro_bias,
-            q("gyro-bias-std", &self.gyro_bias_std, Dimension::AngularRate)?,
+            q(
+                "gyro-bias-std",
+                &self.gyro_bias_std,
+                Dimension::AngularRate,
+                &or_zero(d::ANGULAR_RATE_STD),
+            )?,
         );
         set(
             &mut noise.accel_bias,
@@ -669,6 +700,7 @@ impl AidingOptions {
                 "accel-bias-std",
                 &self.accel_bias_std,
                 Dimension::Acceleration,
+                &or_zero(d::SPECIFIC_FORCE_STD),
             )?,
         );
         set(
@@ -677,6 +709,7 @@ impl AidingOptions {
                 "gyro-scale-std",
                 &self.gyro_scale_std,
                 Dimension::Dimensionless,
+                &d::SCALE_FACTOR,
             )?,
         );
         set(
@@ -685,6 +718,7 @@ impl AidingOptions {
                 "accel-scale-std",
                 &self.accel_scale_std,
                 Dimension::Dimensionless,
+                &d::SCALE_FACTOR,
             )?,
         );
         self.bias_walks(noise)
@@ -693,12 +727,14 @@ impl AidingOptions {
     /// The noise model's bias processes with the flags' overrides: Gauss–Markov
     /// correlation time, instabilities and random walks.
     fn bias_walks(&self, mut noise: ImuNoise) -> Result<ImuNoise> {
-        let q = quantity;
-        let tau_given = q("bias-corr-time", &self.bias_corr_time, Dimension::Time)?;
+        let q = quantity_in;
+        let tau_given = q(
+            "bias-corr-time",
+            &self.bias_corr_time,
+            Dimension::Time,
+            &d::CORRELATION_TIME,
+        )?;
         let tau = tau_given.unwrap_or(3600.0);
-        if tau <= 0.0 {
-            bail!("--bias-corr-time must be positive");
-        }
         if tau_given.is_some() {
             // A correlation time makes the biases Gauss–Markov (as KF-GINS models them).
             noise.gyro_bias_tau = tau;
@@ -709,6 +745,7 @@ impl AidingOptions {
             "gyro-bias-instability",
             &self.gyro_bias_instability,
             Dimension::AngularRate,
+            &or_zero(d::ANGULAR_RATE_STD),
         )?;
         if let Some(x) = gyro {
             noise.gyro_bias_walk = walk(x);
@@ -717,6 +754,7 @@ impl AidingOptions {
             "accel-bias-instability",
             &self.accel_bias_instability,
             Dimension::Acceleration,
+            &or_zero(d::SPECIFIC_FORCE_STD),
         )?;
         if let Some(x) = accel {
             noise.accel_bias_walk = walk(x);
@@ -729,7 +767,12 @@ impl AidingOptions {
         let (rrw, arw) = (&self.rate_random_walk, &self.acceleration_random_walk);
         add(
             &mut noise.gyro_bias_walk,
-            q("rate-random-walk", rrw, Dimension::RateRandomWalk)?,
+            q(
+                "rate-random-walk",
+                rrw,
+                Dimension::RateRandomWalk,
+                &d::RATE_RANDOM_WALK,
+            )?,
         );
         add(
             &mut noise.accel_bias_walk,
@@ -737,6 +780,7 @@ impl AidingOptions {
                 "acceleration-random-walk",
                 arw,
                 Dimension::AccelerationRandomWalk,
+                &d::ACCELERATION_RANDOM_WALK,
             )?,
         );
         Ok(noise)
@@ -789,12 +833,9 @@ impl AidingOptions {
             (None, None, Some(bag)) if !bag.baro.is_empty() => bag.baro.clone(),
             _ => return Ok((Vec::new(), None)),
         };
-        let std = quantity("baro-std", &self.baro_std, Dimension::Length)?.unwrap_or(0.5);
-        let bias =
-            quantity("baro-bias-std", &self.baro_bias_std, Dimension::Length)?.unwrap_or(10.0);
-        if std <= 0.0 || bias <= 0.0 {
-            bail!("--baro-std and --baro-bias-std must be positive");
-        }
+        let length = |flag, v| quantity_in(flag, v, Dimension::Length, &d::POSITION_STD);
+        let std = length("baro-std", &self.baro_std)?.unwrap_or(0.5);
+        let bias = length("baro-bias-std", &self.baro_bias_std)?.unwrap_or(10.0);
         Ok((readings, Some((std, bias))))
     }
 

@@ -10,6 +10,7 @@ use super::AidingOptions;
 use crate::options::quantity;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
+use schuler::domain::VELOCITY_STD;
 use schuler::filter::integration::Counts;
 use schuler::filter::{Baseline, HeadingReading, ImuNoise, VehicleMount};
 use schuler::rotation::Euler;
@@ -136,6 +137,19 @@ pub fn check_dependencies(o: &AidingOptions, given: &GivenVehicle) -> Result<()>
     Ok(())
 }
 
+/// The value of `--flag` with its unit (or `default` when not given) within `domain`
+/// (a measurement's standard deviation: positive, and bounded above so that its
+/// variance and the innovations stay finite).
+fn std_in(
+    flag: &str,
+    v: &Option<String>,
+    dim: Dimension,
+    domain: &schuler::domain::Domain,
+    default: f64,
+) -> Result<f64> {
+    Ok(crate::options::quantity_in(flag, v, dim, domain)?.unwrap_or(default))
+}
+
 /// The value of `--flag` with its unit (or `default` when not given), which must be
 /// positive.
 fn positive(flag: &str, v: &Option<String>, dim: Dimension, default: f64) -> Result<f64> {
@@ -176,14 +190,21 @@ fn rest_config(
         },
         (None, None, false) => return Ok(None),
     };
-    let std = positive("zupt-std", &o.zupt_std, Dimension::Velocity, 0.02)?;
+    let std = std_in(
+        "zupt-std",
+        &o.zupt_std,
+        Dimension::Velocity,
+        &VELOCITY_STD,
+        0.02,
+    )?;
     let zaru_std = if o.zaru {
         // Default: the gyro's white noise averaged over one interval.
         let white = noise.arw.max() / interval.sqrt();
-        Some(positive(
+        Some(std_in(
             "zaru-std",
             &o.zaru_std,
             Dimension::AngularRate,
+            &schuler::domain::ANGULAR_RATE_STD,
             white,
         )?)
     } else {
@@ -217,10 +238,11 @@ fn odometer(
                 (None, Some(path), _) => schuler_io::formats::vehicle::read_odometer(path)?,
                 (None, None, bag) => bag.cloned().unwrap_or_default(),
             };
-            Some(positive(
+            Some(std_in(
                 "odometer-std",
                 &o.odometer_std,
                 Dimension::Velocity,
+                &VELOCITY_STD,
                 0.05,
             )?)
         }
@@ -305,7 +327,13 @@ pub fn resolve(
     let rest = rest_config(o, noise, given.rests, &mut readings.rests)?;
     let nhc = if o.nhc {
         Some((
-            positive("nhc-std", &o.nhc_std, Dimension::Velocity, 0.1)?,
+            std_in(
+                "nhc-std",
+                &o.nhc_std,
+                Dimension::Velocity,
+                &VELOCITY_STD,
+                0.1,
+            )?,
             positive("nhc-interval", &o.nhc_interval, Dimension::Time, 0.1)?,
         ))
     } else {

@@ -75,14 +75,26 @@ pub fn seeds(runs: u64, seed: u64) -> Vec<u64> {
 }
 
 /// `runs` runs of `c` from `seed` on `threads` threads (`None`: one per core), in
-/// seed order; the first failing run's error (naming its seed) if any fails.
+/// seed order; the first failing run's error (naming its seed) if any fails. Both
+/// counts are bounded ([`schuler::domain::RUNS`], [`schuler::domain::THREADS`]).
 pub fn run(
     c: &CampaignConfig,
     runs: u64,
     seed: u64,
     threads: Option<usize>,
 ) -> Result<Vec<RunResult>> {
+    check_counts(runs, threads)?;
     run_seeds(c, &seeds(runs, seed), threads)
+}
+
+/// `--runs` and `--threads` within their bounds, the error naming the flag.
+pub fn check_counts(runs: u64, threads: Option<usize>) -> Result<()> {
+    use crate::options::in_count;
+    in_count("--runs", &schuler::domain::RUNS, runs)?;
+    if let Some(n) = threads {
+        in_count("--threads", &schuler::domain::THREADS, n as u64)?;
+    }
+    Ok(())
 }
 
 /// The runs of `c` with the scenario seeds `seeds`, in their order, on `threads`
@@ -93,6 +105,9 @@ pub fn run_seeds(
     seeds: &[u64],
     threads: Option<usize>,
 ) -> Result<Vec<RunResult>> {
+    if let Some(n) = threads {
+        crate::options::in_count("--threads", &schuler::domain::THREADS, n as u64)?;
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()

@@ -22,6 +22,16 @@ pub struct Recorded {
     pub baro: Vec<(f64, f64)>,
 }
 
+/// The IMU samples one run may hold: 2^21 (35 min at 1 kHz, 2.9 h at 200 Hz). Each
+/// costs 144 bytes with its truth, so a run holds at most 300 MB (twice that while its
+/// vectors grow), and a campaign as many runs as it has threads.
+pub const HELD_SAMPLES: schuler::domain::Count = schuler::domain::Count {
+    quantity: "IMU samples held by one run",
+    min: 0,
+    max: 1 << 21,
+    why: "a campaign holds each run in memory; shorten the scenario or lower imu.rate_hz",
+};
+
 impl SimSink for Recorded {
     fn imu(
         &mut self,
@@ -30,6 +40,9 @@ impl SimSink for Recorded {
         truth: &NavState,
         _kin: &Kinematics,
     ) -> std::io::Result<()> {
+        HELD_SAMPLES
+            .check(self.imu.len() as u64 + 1)
+            .map_err(std::io::Error::other)?;
         self.imu.push(*measured);
         self.truth.push(truth.into());
         Ok(())

@@ -16,6 +16,13 @@ use schuler::session::MechanizationConfig;
 use schuler_io::formats::ImuReadOptions;
 use std::path::{Path, PathBuf};
 
+/// The rate of the navigation output [Hz]: positive, at most the fastest IMU's.
+const OUTPUT_RATE: schuler::domain::Domain = schuler::domain::Domain {
+    quantity: "output rate",
+    min: f64::MIN_POSITIVE,
+    ..schuler::domain::IMU_RATE
+};
+
 /// The mechanization options of flags over config, checked.
 fn mechanization_config(args: &NavArgs, cfg: &NavConfig) -> Result<MechanizationConfig> {
     let choice = args.mechanization.or(cfg.mechanization).unwrap_or_default();
@@ -149,9 +156,13 @@ fn plan(args: NavArgs, cfg: NavConfig) -> Result<NavPlan> {
         .as_deref()
         .and_then(Path::parent)
         .unwrap_or(Path::new(""));
-    let aiding = args
-        .aiding
-        .or(cfg.aiding.unwrap_or_default().relative_to(base));
+    let from_config = cfg.aiding.unwrap_or_default().relative_to(base);
+    if args.config.is_some() {
+        let files = [("imu", cfg.imu.as_deref()), ("bag", cfg.bag.as_deref())];
+        let files = files.into_iter().filter_map(|(k, p)| Some((k, p?)));
+        config_files_exist(files.chain(from_config.input_files()))?;
+    }
+    let aiding = args.aiding.or(from_config);
     Ok(NavPlan {
         settings,
         align: align_on,
@@ -161,6 +172,16 @@ fn plan(args: NavArgs, cfg: NavConfig) -> Result<NavPlan> {
         axes_given,
         bag,
     })
+}
+
+/// Every input file a configuration names can be opened: else the error names its
+/// key (the caller adds the file), not only the path.
+fn config_files_exist<'a>(files: impl Iterator<Item = (&'a str, &'a Path)>) -> Result<()> {
+    for (key, path) in files {
+        std::fs::metadata(path)
+            .with_context(|| format!("`{key} = {:?}`: cannot open it", path.display()))?;
+    }
+    Ok(())
 }
 
 /// The run's settings of flags over config, checked (the IMU log or the bag, the
@@ -189,7 +210,11 @@ fn settings(
         },
         init_vel: Vector3::from(args.init_vel.or(cfg.init_vel).unwrap_or(Triple([0.0; 3])).0),
         init_att: init_att(args, cfg, align_on || in_motion)?,
-        output_rate: rate("output-rate", args.output_rate.or(cfg.output_rate))?,
+        output_rate: rate(
+            "output-rate",
+            &OUTPUT_RATE,
+            args.output_rate.or(cfg.output_rate),
+        )?,
         out: args
             .out
             .clone()

@@ -307,12 +307,7 @@ impl ImuSpec {
 
     /// The SI model.
     pub fn model(&self) -> Result<ImuModel, ScenarioError> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
-            return Err(ScenarioError::Value {
-                key: "imu.rate_hz".into(),
-                message: format!("must be a positive number of Hz, got {}", self.rate_hz),
-            });
-        }
+        within(&domain::IMU_RATE, "imu.rate_hz", self.rate_hz)?;
         let r = self.resolved_spec();
         let gyro = r.gyro.resolve(
             "imu.gyro",
@@ -468,12 +463,7 @@ const SIM_OFFSET: Domain = Domain {
 impl GnssSpec {
     /// The SI model.
     pub fn model(&self) -> Result<GnssModel, ScenarioError> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
-            return Err(ScenarioError::Value {
-                key: "gnss.rate_hz".into(),
-                message: format!("must be a positive number of Hz, got {}", self.rate_hz),
-            });
-        }
+        within(&domain::GNSS_RATE, "gnss.rate_hz", self.rate_hz)?;
         let zero = || Ok(Vector3::zeros());
         Ok(GnssModel {
             interval: 1.0 / self.rate_hz,
@@ -549,12 +539,7 @@ pub struct BaroOutlierSpec {
 impl BaroSpec {
     /// The SI model.
     pub fn model(&self) -> Result<BaroModel, ScenarioError> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
-            return Err(ScenarioError::Value {
-                key: "baro.rate_hz".into(),
-                message: format!("must be a positive number of Hz, got {}", self.rate_hz),
-            });
-        }
+        within(&domain::AID_RATE, "baro.rate_hz", self.rate_hz)?;
         let opt = |q: &Option<Quantity>, key: &str, dim, domain: &Domain| {
             q.as_ref()
                 .map_or(Ok(0.0), |q| within(domain, key, q.si(key, dim)?))
