@@ -302,6 +302,8 @@ pub fn explain(e: ChannelError) -> anyhow::Error {
             "duration" => Some("--duration"),
             "radius" => Some("--radius"),
             "gravitational parameter" => Some("--g"),
+            "earth rate" => Some("--earth-rate"),
+            "speed" => Some("--speed"),
             _ => None,
         },
         _ => None,

@@ -117,12 +117,50 @@ impl ChannelConfig {
         speed.chain(turns).fold(0.0, f64::max)
     }
 
+    /// The vehicle stays on the sphere: the specific force `f_x1 = μ/a² − (V/a + ω)² a`
+    /// (5) is positive at the start and after every speed change (the speed is
+    /// monotone in between). An Earth turning at the Schuler frequency `sqrt(g/a)` or
+    /// faster, or a speed at orbital velocity, flings it off: the linear model's
+    /// `ω0 = sqrt(f/a)` (13) is then no longer real and the closed forms are NaN.
+    fn held_down(&self) -> Result<(), ChannelError> {
+        let truth = self.truth();
+        let ends = self.speed.changes.iter().map(|c| c.start + c.duration);
+        let Some(t) = std::iter::once(0.0)
+            .chain(ends)
+            .find(|&t| !(truth.specific_force(t).0 > 0.0))
+        else {
+            return Ok(());
+        };
+        let (a, w) = (self.earth.radius, self.earth.rotation_rate);
+        let schuler = (self.earth.mu / a.powi(3)).sqrt();
+        let name = if w.abs() >= schuler {
+            "earth rate"
+        } else {
+            "speed"
+        };
+        Err(ChannelError::OutOfRange {
+            name,
+            value: if name == "speed" {
+                self.speed.speed(t)
+            } else {
+                w
+            },
+            reason: format!(
+                "at t = {t} s gravity no longer holds the vehicle on the sphere: the Earth \
+                 rate must stay below the Schuler frequency sqrt(g/a) = {schuler:e} rad/s and \
+                 the inertial speed V + a w below the orbital speed sqrt(g a) = {:.0} m/s",
+                (self.earth.mu / a).sqrt()
+            ),
+        })
+    }
+
     /// Checks every input (finite, positive where needed, step fine enough).
     pub fn validate(&self) -> Result<(), ChannelError> {
         positive("radius", self.earth.radius)?;
         positive("gravitational parameter", self.earth.mu)?;
         finite("earth rate", self.earth.rotation_rate)?;
         self.speed.validate()?;
+        self.held_down()?;
         self.body.validate()?;
         let s = &self.sensors;
         finite("accelerometer bias", s.accel_bias)?;
