@@ -87,7 +87,14 @@ pub fn html(what: &str, rows: &[RunRow], a: &Aggregate) -> Report {
     let mut t =
         Table::new(["quantity", "mean", "std", "min", "max", "runs"]).caption("Over the runs");
     for (name, c) in COLUMNS.iter().zip(&a.columns) {
-        let f = |x: f64| format!("{x:.4}");
+        // A column without a value (no outage) or a spread of one run has none.
+        let f = |x: f64| {
+            if x.is_finite() {
+                format!("{x:.4}")
+            } else {
+                "–".to_owned()
+            }
+        };
         t = t.row([
             name.to_string(),
             f(c.mean),

@@ -111,13 +111,18 @@ impl RunRow {
 }
 
 /// The table as CSV: a header, then one line per row; numbers in Rust's shortest form
-/// that reads back to the same bits (`NaN` where none).
+/// that reads back to the same bits, an empty field where a run has none (no outage,
+/// no accepted measurement: CSV's missing value, read back as NaN by pandas).
 pub fn csv(rows: &[RunRow]) -> String {
     let mut s = format!("seed,{}\n", COLUMNS.join(","));
     for r in rows {
         let _ = write!(s, "{}", r.seed);
         for v in r.values {
-            let _ = write!(s, ",{v:?}");
+            if v.is_finite() {
+                let _ = write!(s, ",{v:?}");
+            } else {
+                s.push(',');
+            }
         }
         s.push('\n');
     }
