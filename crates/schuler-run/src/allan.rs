@@ -139,10 +139,15 @@ fn to_unit(v: f64, unit: &str) -> f64 {
     Unit::parse(unit).map_or(f64::NAN, |u| u.from_si(v))
 }
 
-/// Four significant digits: plain between 1e-3 and 1e6, exponent form outside.
+/// Four significant digits: plain between 1e-3 and 1e6, exponent form outside; an
+/// interval's open end (infinite) as `unbounded`, a missing value as `n/a`.
 fn sig(x: f64) -> String {
     let a = x.abs();
-    if x == 0.0 || !x.is_finite() {
+    if x.is_nan() {
+        "n/a".to_owned()
+    } else if x.is_infinite() {
+        format!("{}unbounded", if x < 0.0 { "-" } else { "" })
+    } else if x == 0.0 {
         format!("{x}")
     } else if (1e-3..1e6).contains(&a) {
         let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
@@ -197,7 +202,8 @@ fn read(args: &Args) -> Result<(Vec<ImuSample>, Option<String>)> {
     let gaps = reader.gaps();
     let gap_warning = (!gaps.is_empty()).then(|| {
         format!(
-            "{}: {gaps}: the Allan variance assumes uniform sampling",
+            "{}: {gaps}: the samples spanning a gap are left out and the uniformly sampled \
+             stretches between gaps pooled (no cluster spans a gap)",
             args.imu.display()
         )
     });
@@ -645,7 +651,10 @@ pub fn noise_toml(path: &Path, allan: &ImuAllan, fits: &[ChannelFit]) -> String 
     }
     s += "[aiding]\n";
     let mut key = |name: &str, v: Option<(f64, bool)>, unit: &str| {
-        if let Some((v, resolved)) = v {
+        if let Some((v, _)) = v.filter(|v| !v.0.is_finite()) {
+            // An unbounded term: no value nav could use (the log is too short for it).
+            let _ = writeln!(s, "# {name}: not bounded by this log ({})", sig(v));
+        } else if let Some((v, resolved)) = v {
             let note = if resolved {
                 ""
             } else {

@@ -30,20 +30,33 @@ use crate::imu::ImuSample;
 /// The integrated signal of one channel: `θ_0 = 0`, `θ_{k+1} = θ_k + (x_k − x̄)` for
 /// increments `x_k` over `dt` seconds each (the mean `x̄` removed: a constant rate
 /// has no Allan variance, and the sums stay small against the noise).
+///
+/// A log with gaps is a set of uniformly sampled segments: `θ` runs on over the gap
+/// (the sample that spans it left out), and a second difference is taken only inside
+/// one segment, so the overlapping sum pools the segments' terms (Riley, NIST SP 1065
+/// §5.2.4 applied to each segment, the sums and counts added).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cumulative {
     theta: Vec<f64>,
     dt: f64,
+    /// Indices of `θ` where one segment ends and the next begins (increasing).
+    breaks: Vec<usize>,
 }
 
 impl Cumulative {
     /// The running sum of `increments` (one per `dt` seconds), mean removed.
     pub fn new(increments: &[f64], dt: f64) -> Self {
-        Self::from_iter(increments.iter().copied(), increments.len(), dt)
+        Self::from_iter(increments.iter().copied(), increments.len(), dt, Vec::new())
     }
 
-    /// The running sum of `n` increments given by `values` twice (once for the mean).
-    fn from_iter(values: impl Iterator<Item = f64> + Clone, n: usize, dt: f64) -> Self {
+    /// The running sum of `n` increments given by `values` twice (once for the mean),
+    /// segments ending at the `θ` indices `breaks`.
+    fn from_iter(
+        values: impl Iterator<Item = f64> + Clone,
+        n: usize,
+        dt: f64,
+        breaks: Vec<usize>,
+    ) -> Self {
         let mean = values.clone().sum::<f64>() / n.max(1) as f64;
         let mut theta = Vec::with_capacity(n + 1);
         theta.push(0.0);
@@ -52,7 +65,7 @@ impl Cumulative {
             acc += x - mean;
             theta.push(acc);
         }
-        Self { theta, dt }
+        Self { theta, dt, breaks }
     }
 
     /// Number of increments `N`.
@@ -60,21 +73,30 @@ impl Cumulative {
         self.theta.len() - 1
     }
 
+    /// The segments as ranges of `θ` indices `[start, end)`.
+    fn segments(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        let ends = self.breaks.iter().copied().chain([self.theta.len() - 1]);
+        let starts = std::iter::once(0).chain(self.breaks.iter().copied());
+        starts.zip(ends).map(|(a, b)| a..b + 1)
+    }
+
     /// Number of second differences in the overlapping sum at cluster size `m`:
-    /// `N + 1 − 2m` (0 when there are none).
+    /// `N + 1 − 2m` (0 when there are none), summed over the segments.
     pub fn terms(&self, m: usize) -> usize {
-        self.theta.len().saturating_sub(2 * m)
+        self.segments().map(|r| r.len().saturating_sub(2 * m)).sum()
     }
 
     /// Allan variance `σ²(m dt)` of the rate [(unit/s)²] (module doc); `None` if `m`
-    /// is 0 or there are fewer than `2m + 1` points of `θ`.
+    /// is 0 or no segment holds `2m + 1` points of `θ`.
     pub fn avar(&self, m: usize) -> Option<f64> {
         let terms = self.terms(m);
         if m == 0 || terms == 0 {
             return None;
         }
         let t = &self.theta;
-        let sum: f64 = (0..terms)
+        let sum: f64 = self
+            .segments()
+            .flat_map(|r| r.start..r.end.saturating_sub(2 * m))
             .map(|k| {
                 let d = t[k + 2 * m] - 2.0 * t[k + m] + t[k];
                 d * d
@@ -165,6 +187,17 @@ impl AllanCurve {
     pub fn from_increments(increments: &[f64], dt: f64, sizes: &[usize]) -> Self {
         Self::of(&Cumulative::new(increments, dt), sizes)
     }
+}
+
+/// The median of the samples' intervals [s] (0 without samples): the log's usual
+/// interval, which a few gaps do not move.
+fn median_interval(samples: &[ImuSample]) -> f64 {
+    let mut dt: Vec<f64> = samples.iter().map(|s| s.dt).collect();
+    if dt.is_empty() {
+        return 0.0;
+    }
+    let mid = dt.len() / 2;
+    *dt.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// Names of the six channels, in [`ImuAllan::channels`] order.
@@ -264,8 +297,27 @@ impl ImuAllan {
         }) {
             return Err(AllanError::BadSample { index, t: s.t });
         }
-        let n = samples.len();
-        let span: f64 = samples.iter().map(|s| s.dt).sum();
+        // A sample whose interval is over half again the usual spans a gap: it is left
+        // out and the segments on either side are pooled (see [`Cumulative`]). Its
+        // increment is the sensor's over its own interval (increment logs) or the
+        // rate times the whole gap (rate logs); either way not one `dt`'s.
+        let usual = median_interval(samples);
+        let spans_gap = |s: &ImuSample| s.dt > 1.5 * usual;
+        let kept = || samples.iter().filter(|s| !spans_gap(s));
+        let mut breaks = Vec::new();
+        let mut k = 0;
+        for s in samples {
+            if spans_gap(s) {
+                if k > 0 && breaks.last() != Some(&k) {
+                    breaks.push(k);
+                }
+            } else {
+                k += 1;
+            }
+        }
+        let breaks = breaks.into_iter().filter(|&b| b < k).collect::<Vec<_>>();
+        let n = k;
+        let span: f64 = kept().map(|s| s.dt).sum();
         let dt = span / n.max(1) as f64;
         let max_tau = options.max_tau.unwrap_or(span / 10.0);
         if !(n > 0 && 10.0 * max_tau <= span * (1.0 + 1e-12)) {
@@ -285,14 +337,10 @@ impl ImuAllan {
         }
         let sizes = cluster_sizes(options.per_decade, (max_tau / dt + 1e-9) as usize);
         let channel = |c: usize| {
-            let x = samples
-                .iter()
-                .map(move |s| if c < 3 { s.dtheta[c] } else { s.dvel[c - 3] });
+            let x = kept().map(move |s| if c < 3 { s.dtheta[c] } else { s.dvel[c - 3] });
             let mean = x.clone().sum::<f64>() / span;
-            (
-                AllanCurve::of(&Cumulative::from_iter(x, n, dt), &sizes),
-                mean,
-            )
+            let cumulative = Cumulative::from_iter(x, n, dt, breaks.clone());
+            (AllanCurve::of(&cumulative, &sizes), mean)
         };
         let curves: [(AllanCurve, f64); 6] = std::array::from_fn(channel);
         Ok(Self {
