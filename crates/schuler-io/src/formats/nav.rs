@@ -5,7 +5,9 @@
 //! roll pitch yaw`, degrees, metres, m/s; as schuler's `nav.txt`, KF-GINS's
 //! `KF_GINS_Navresult.nav` and the data sets' `truth.nav`) or schuler's `nav.csv` (a
 //! header naming at least `t_sow,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,
-//! pitch_deg,yaw_deg`, in any order, other columns ignored). The format is told by the
+//! pitch_deg,yaw_deg`, in any order, other columns ignored; the time may be named `t`,
+//! as in `schuler simulate`'s `truth.csv`). Every value is checked in its physical
+//! domain ([`schuler::domain`]); longitudes in 0..360 are wrapped. The format is told by the
 //! first data line: a header starts with a letter. Fields are separated by spaces,
 //! tabs, commas or semicolons (a CSV's as its header's are); blank lines and `#`/`%`
 //! comments are skipped. The time is the second of week; in a KF-GINS file a later week continues
@@ -14,7 +16,7 @@
 //! [`NavReader`] reads a file an epoch at a time; [`read_nav`] reads it whole (80
 //! bytes per epoch).
 
-use super::error::{InputError, InputErrorKind, quote_field};
+use super::error::{InputError, InputErrorKind, in_domain, quote_field};
 use super::gps_time::WeekClock;
 use super::lines::{Delimiter, MAX_LINE_BYTES, fields, is_skippable, too_long};
 use nalgebra::Vector3;
@@ -61,6 +63,9 @@ const CSV_FIELDS: [&str; 10] = [
     "pitch_deg",
     "yaw_deg",
 ];
+
+/// The other name of the CSV time column, `t_sow`: `schuler simulate`'s truth.csv.
+const TIME_ALIAS: &str = "t";
 
 /// Names of the values a data line gives, in [`NavRecord`] order, as a KF-GINS
 /// line's errors name them.
@@ -174,13 +179,26 @@ fn record(
     prev_t: Option<f64>,
 ) -> Result<NavRecord, InputError> {
     let at = |field: &str, kind, msg: String| InputError::new(kind, path, n, Some(field), msg);
-    if !(-90.0..=90.0).contains(&v[1]) {
-        return Err(at(
-            names[1],
-            InputErrorKind::NotANumber,
-            format!("latitude {} is outside [-90, 90]", v[1]),
-        ));
+    // Every value in its physical domain: a height of 1e308 or a longitude of 7680 deg
+    // is a corrupt line, not an error of thousands of kilometres to report.
+    use schuler::domain as d;
+    let domains: [&d::Domain; 10] = [
+        &d::TIME,
+        &d::LATITUDE,
+        &d::LONGITUDE,
+        &d::HEIGHT,
+        &d::SPEED,
+        &d::SPEED,
+        &d::SPEED,
+        &d::HEADING,
+        &d::PITCH,
+        &d::HEADING,
+    ];
+    for (k, domain) in domains.iter().enumerate() {
+        in_domain(path, n, names[k], domain, v[k])?;
     }
+    let lon = d::wrap_longitude(v[2].to_radians())
+        .map_err(|e| at(names[2], InputErrorKind::OutOfDomain, e.to_string()))?;
     if let Some(prev) = prev_t
         && v[0] <= prev
     {
@@ -192,7 +210,7 @@ fn record(
     }
     Ok(NavRecord {
         t_sow: v[0],
-        pos: Geodetic::from_degrees(v[1], v[2], v[3]),
+        pos: Geodetic::new(v[1].to_radians(), lon, v[3]),
         v_n: Vector3::new(v[4], v[5], v[6]),
         att: Euler::from_degrees(v[7], v[8], v[9]),
     })
@@ -346,14 +364,20 @@ fn csv_header(path: &Path, n: u64, l: &str) -> Result<CsvColumns, InputError> {
         .collect();
     let mut index = [0usize; 10];
     for (k, want) in CSV_FIELDS.iter().enumerate() {
-        index[k] = names.iter().position(|h| h == want).ok_or_else(|| {
+        // `schuler simulate`'s truth.csv names its time `t` (the scenario's clock, not a
+        // second of week); its other columns are these.
+        let alias = (k == 0).then_some(TIME_ALIAS);
+        let found = names.iter().position(|h| h == want);
+        let found = found.or_else(|| alias.and_then(|a| names.iter().position(|h| *h == a)));
+        index[k] = found.ok_or_else(|| {
             InputError::new(
                 InputErrorKind::Header,
                 path,
                 n,
                 Some(want),
                 format!(
-                    "the header lacks column {want} (needs {})",
+                    "the header lacks column {want} (needs {}; the time may be named \
+                     {TIME_ALIAS})",
                     CSV_FIELDS.join(",")
                 ),
             )
