@@ -474,6 +474,13 @@ impl<'a> CsvHeader<'a> {
     /// name given twice is an error.
     fn find(&self, name: &str) -> Result<Option<usize>, InputError> {
         let aliases: &[&str] = if name == "t" { &["t", "time"] } else { &[name] };
+        self.find_any(name, aliases)
+    }
+
+    /// The column holding `name` under any of `aliases` (ASCII case-insensitive), if
+    /// any; two columns holding it (the same name twice, or two of its aliases) are an
+    /// error naming both.
+    fn find_any(&self, name: &str, aliases: &[&str]) -> Result<Option<usize>, InputError> {
         let found: Vec<usize> = (0..self.names.len())
             .filter(|&i| {
                 aliases
@@ -1012,23 +1019,21 @@ const BARO_TIME_NAMES: [&str; 3] = ["t", "time", "timestamp"];
 /// Names of a barometer header's height column [m] (any case).
 const BARO_HEIGHT_NAMES: [&str; 6] = ["h_m", "h", "height", "height_m", "alt", "altitude"];
 
-/// The time and height columns a barometer header (line `n`) names.
-fn baro_columns(path: &Path, n: u64, header: &str) -> Result<[usize; 2], InputError> {
-    let names: Vec<String> = fields(header).map(str::to_lowercase).collect();
-    let find = |wanted: &[&str]| names.iter().position(|n| wanted.contains(&n.as_str()));
-    match (find(&BARO_TIME_NAMES), find(&BARO_HEIGHT_NAMES)) {
+/// The time and height columns a barometer header names: each once (a name given
+/// twice, or two of its names, is refused rather than one of them read).
+fn baro_columns(header: &CsvHeader) -> Result<[usize; 2], InputError> {
+    let t = header.find_any("t", &BARO_TIME_NAMES)?;
+    let h = header.find_any("h", &BARO_HEIGHT_NAMES)?;
+    match (t, h) {
         (Some(t), Some(h)) => Ok([t, h]),
-        _ => Err(InputError::new(
-            InputErrorKind::Header,
-            path,
-            n,
+        _ => Err(header.error(
             None,
             format!(
                 "a barometer header names its time ({}) and its height in metres ({}); \
                  this one names {}",
                 BARO_TIME_NAMES.join(", "),
                 BARO_HEIGHT_NAMES.join(", "),
-                names.join(", ")
+                header.names.join(", ")
             ),
         )),
     }
@@ -1041,27 +1046,40 @@ fn baro_columns(path: &Path, n: u64, header: &str) -> Result<[usize; 2], InputEr
 pub fn read_baro(path: &Path) -> Result<Vec<(f64, f64)>, InputError> {
     let text = read_text(path)?;
     let mut lines = data_lines(&text).peekable();
-    let [tc, hc] = match lines.peek() {
+    let header = match lines.peek() {
         Some(&(n, l)) if is_header(l) => {
             lines.next();
-            baro_columns(path, n, l)?
+            let header = CsvHeader::parse(path, n, l);
+            let columns = baro_columns(&header)?;
+            Some((header, columns))
         }
-        _ => [0, 1],
+        _ => None,
     };
     let mut out: Vec<(f64, f64)> = Vec::new();
     for (n, l) in lines {
-        let f: Vec<&str> = fields(l).collect();
-        if f.len() <= tc.max(hc) {
-            return Err(InputError::new(
-                InputErrorKind::ColumnCount,
-                path,
-                n,
-                None,
-                format!("{} fields, expected t and h", f.len()),
-            ));
-        }
-        let t = parse_field(path, n, "time", f[tc], "")?;
-        let h = parse_field(path, n, "h", f[hc], "")?;
+        let [t, h] = match &header {
+            // As many fields as the header names, the two read by their names.
+            Some((header, [tc, hc])) => {
+                let v = header.row(n, l, &[(*tc, "time"), (*hc, "h")], "")?;
+                [v[0], v[1]]
+            }
+            None => {
+                let f: Vec<&str> = fields(l).collect();
+                if f.len() < 2 {
+                    return Err(InputError::new(
+                        InputErrorKind::ColumnCount,
+                        path,
+                        n,
+                        None,
+                        format!("{} fields, expected t and h", f.len()),
+                    ));
+                }
+                [
+                    parse_field(path, n, "time", f[0], "")?,
+                    parse_field(path, n, "h", f[1], "")?,
+                ]
+            }
+        };
         let h = in_domain(path, n, "h", &domain::HEIGHT, h)?;
         check_time(path, n, "time", t, out.last().map(|p| p.0))?;
         out.push((t, h));
