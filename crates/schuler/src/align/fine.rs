@@ -58,6 +58,9 @@ pub struct Convergence {
 pub struct FineAlignment {
     /// Attitude at the end, body to NED.
     pub q_bn: UnitQuaternion<f64>,
+    /// The filter's estimate of the attitude at its start (the reference attitude
+    /// state, corrected window by window from the coarse attitude it began with).
+    pub q_start: UnitQuaternion<f64>,
     /// End time [s].
     pub t_end: f64,
     /// Estimated gyro biases [rad/s].
@@ -221,6 +224,7 @@ pub fn fine_align<E: EarthModel>(
     let end = mech.state();
     FineAlignment {
         q_bn: end.q_bn,
+        q_start: q_ref,
         t_end: end.t,
         gyro_bias: bg,
         accel_bias: ba,

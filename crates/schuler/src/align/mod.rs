@@ -30,6 +30,7 @@ use crate::filter::kalman::duplicate_states;
 use crate::filter::{ImuNoise, Layout};
 use crate::imu::ImuSample;
 use crate::nav::NavState;
+use crate::rotation::Euler;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use std::fmt;
 
@@ -97,6 +98,21 @@ pub enum AlignError {
     },
     /// The specific force is zero (not a base at rest).
     NoGravity,
+    /// The fine stage's estimate of the attitude it started from contradicts the
+    /// coarse stage that gave it ([`coarse_consistency`]): the data do not behave as
+    /// a base at rest with this IMU's noise.
+    Inconsistent {
+        /// The chi-square statistic.
+        chi2: f64,
+        /// Its degrees of freedom.
+        dof: usize,
+        /// The threshold it exceeds.
+        threshold: f64,
+        /// The fine stage's correction of the coarse heading [rad].
+        heading_change: f64,
+        /// What the motion detector saw (angular motion, vibration).
+        moving: bool,
+    },
 }
 
 impl fmt::Display for AlignError {
@@ -130,6 +146,28 @@ impl fmt::Display for AlignError {
             AlignError::NoGravity => {
                 write!(f, "the mean specific force is zero: not a base at rest")
             }
+            AlignError::Inconsistent {
+                chi2,
+                dof,
+                threshold,
+                heading_change,
+                moving,
+            } => write!(
+                f,
+                "the fine stage moved the coarse attitude by {:.3} deg of heading, {:.1} \
+                 standard deviations (chi-square {chi2:.1} on {dof} degrees of freedom, \
+                 threshold {threshold:.1}): its own stages contradict each other, so no \
+                 heading is given. {}",
+                heading_change.to_degrees(),
+                chi2.sqrt(),
+                if *moving {
+                    "The base moved (motion detected): align at rest, or in motion with GNSS"
+                } else {
+                    "The log does not behave as a base at rest with this noise model: \
+                     columns swapped or units wrong (--imu-columns, --gyro-unit), or the \
+                     noise model far too optimistic (--imu-grade)"
+                }
+            ),
         }
     }
 }
@@ -174,6 +212,39 @@ pub struct Alignment {
     pub t_end: f64,
     /// Run time of the pre-filter, the coarse and the fine stage [s] (wall clock).
     pub stage_seconds: [f64; 3],
+}
+
+/// Probability beyond which the fine stage's correction of the coarse attitude
+/// refuses an alignment ([`coarse_consistency`]): `1 − 1e-6`, so that a consistent
+/// filter on a base at rest is refused once in a million alignments, while a log that
+/// is not at rest (hundreds of standard deviations) always is.
+pub const CONSISTENCY_PROBABILITY: f64 = 1.0 - 1e-6;
+
+/// The chi-square test of the fine stage against the coarse one: the fine filter
+/// estimates the error of the attitude it started from (its reference-attitude
+/// state, prior mean zero, prior covariance `P₀` the coarse stage's). For a
+/// consistent linear filter the estimate `δ` and its error are uncorrelated, so
+/// `cov δ = P₀ − P₁` (`P₁` the posterior) and `δᵀ (P₀ − P₁)⁺ δ` is chi-square with
+/// the rank of `P₀ − P₁` degrees of freedom (Bar-Shalom, Li & Kirubarajan 2001,
+/// §5.4: the same logic as the innovation test). Returns `(statistic, dof)`.
+pub fn coarse_consistency(
+    delta: &Vector3<f64>,
+    prior: &Matrix3<f64>,
+    posterior: &Matrix3<f64>,
+) -> (f64, usize) {
+    let d = (prior - posterior).symmetric_eigen();
+    let largest = d.eigenvalues.max().max(0.0);
+    let mut chi2 = 0.0;
+    let mut dof = 0;
+    for (i, &l) in d.eigenvalues.iter().enumerate() {
+        // Directions the data did not inform (no variance drop) carry no test.
+        if l > 1e-9 * largest && l > 0.0 {
+            let x = d.eigenvectors.column(i).dot(delta);
+            chi2 += x * x / l;
+            dof += 1;
+        }
+    }
+    (chi2, dof)
 }
 
 /// A state the filter reduced to less than this fraction of its prior counts as
@@ -354,11 +425,35 @@ pub fn align<E: EarthModel>(
         pos,
         &data[split..],
         coarse.q_bn,
-        prior,
+        prior.clone(),
         noise,
         &still,
     );
     let p = &fine.covariance;
+    let r_ref = Layout::core()
+        .with_attitude_ref()
+        .attitude_ref
+        .unwrap_or(15);
+    let delta =
+        crate::rotation::rotation_vector_from_quaternion(&(fine.q_start * coarse.q_bn.inverse()));
+    let (chi2, dof) = coarse_consistency(
+        &delta,
+        &prior.fixed_view::<3, 3>(r_ref, r_ref).into_owned(),
+        &p.fixed_view::<3, 3>(r_ref, r_ref).into_owned(),
+    );
+    let threshold = crate::filter::kalman::chi_square_quantile(dof, CONSISTENCY_PROBABILITY);
+    if chi2 > threshold {
+        return Err(AlignError::Inconsistent {
+            chi2,
+            dof,
+            threshold,
+            heading_change: crate::rotation::wrap_pi(
+                Euler::from_quaternion(&fine.q_start).yaw
+                    - Euler::from_quaternion(&coarse.q_bn).yaw,
+            ),
+            moving: motion.angular_motion || motion.vibration,
+        });
+    }
     let p_psi = p.fixed_view::<3, 3>(Layout::ATT, Layout::ATT).into_owned();
     let std = |o: usize| crate::filter::kalman::std3(p, o);
     let names = Layout::core().with_attitude_ref().names();
