@@ -45,8 +45,27 @@ enum Command {
     Montecarlo(schuler_cli::commands::montecarlo::Args),
 }
 
+/// `cmd` and its subcommands with every option that takes a value accepting one that
+/// starts with a hyphen (`--start -1`, `--max-tau -5s`, `--seed -1`): without it clap
+/// reads `-1` as an unknown flag and its error does not name the option; with it the
+/// option's own check does. Options whose value is optional (`--earth-rate` alone) or
+/// that take several keep clap's reading, so that a following flag is not taken for
+/// their value.
+fn hyphen_values(cmd: clap::Command) -> clap::Command {
+    cmd.mut_args(|a| {
+        let one = a
+            .get_num_args()
+            .is_none_or(|n| n.min_values() == 1 && n.max_values() == 1);
+        let takes = a.get_action().takes_values() && !a.is_positional() && one;
+        a.allow_hyphen_values(takes)
+    })
+    .mut_subcommands(hyphen_values)
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    use clap::{CommandFactory, FromArgMatches};
+    let matches = hyphen_values(Cli::command()).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Nav(args) => schuler_cli::commands::run_nav(args),
         Command::Align(args) => schuler_cli::commands::align::run(args),

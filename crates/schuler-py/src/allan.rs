@@ -119,7 +119,9 @@ pub fn allan_fit<'py>(
                     let gaps = reader.gaps();
                     if !gaps.is_empty() {
                         warnings.push(format!(
-                            "{}: {gaps}: the Allan variance assumes uniform sampling",
+                            "{}: {gaps}: the samples spanning a gap are left out and the \
+                             uniformly sampled stretches between gaps pooled (no cluster \
+                             spans a gap)",
                             args.imu.display()
                         ));
                     }

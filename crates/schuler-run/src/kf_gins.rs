@@ -235,7 +235,8 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
 pub fn run_kf_gins(path: &Path, opts: &KfGinsOptions) -> Result<(KfGinsRun, RunSummary)> {
     let run = load(path, opts)?;
     let (settings, aiding) = (&run.settings, &run.aiding);
-    let reader = schuler_io::formats::ImuReader::open(&settings.imu, &settings.read)?;
+    let reader = schuler_io::formats::ImuReader::open(&settings.imu, &settings.read)
+        .with_context(|| format!("{}: imupath", path.display()))?;
     // Read and parsed on a second thread, overlapping the navigation; the samples
     // come in the same order, so the files are the same bytes.
     let mut reader = reader.read_ahead()?;

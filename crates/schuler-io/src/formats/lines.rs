@@ -72,8 +72,8 @@ pub(crate) fn for_each_data_line(
     }
 }
 
-/// A configuration file's text, at most [`MAX_CONFIG_BYTES`], without a leading
-/// byte-order mark.
+/// A configuration file's text, at most [`MAX_CONFIG_BYTES`] and lines shorter than
+/// [`MAX_LINE_BYTES`], without a leading byte-order mark.
 pub fn read_config_text(path: &Path) -> Result<String, InputError> {
     let file = std::fs::File::open(path).map_err(|e| cannot_read(path, &e))?;
     let mut bytes = Vec::new();
@@ -94,6 +94,13 @@ pub fn read_config_text(path: &Path) -> Result<String, InputError> {
     }
     if bytes.starts_with(BOM) {
         bytes.drain(..BOM.len());
+    }
+    // A configuration's lines are short: a longer one is not a configuration, and a
+    // parser's error would quote it whole (a 10-MB line, twice, on stderr).
+    for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if line.len() as u64 >= MAX_LINE_BYTES {
+            return Err(too_long(path, k as u64 + 1));
+        }
     }
     String::from_utf8(bytes).map_err(|e| {
         InputError::new(

@@ -176,6 +176,23 @@ fn micros(t: NaiveTime) -> i64 {
     i64::from(t.num_seconds_from_midnight()) * 1_000_000 + i64::from(t.nanosecond() / 1000)
 }
 
+/// Why the NMEA parser refused a sentence, in the user's words: a malformed field or
+/// checksum rather than the parser's internals (`Parsing Error: Error { input: ..,
+/// code: OneOf }`).
+fn bad_sentence(e: &::nmea::Error) -> String {
+    use ::nmea::Error as E;
+    match e {
+        E::ParsingError(_) => "a malformed or missing field".to_owned(),
+        E::ChecksumMismatch { calculated, found } => {
+            format!("checksum {found:02X} where the sentence's bytes give {calculated:02X}")
+        }
+        E::SentenceLength(n) => format!("{n} characters, longer than a sentence"),
+        E::ParameterLength { .. } => "a field longer than its format allows".to_owned(),
+        E::Utf8Decoding | E::ASCII => "characters that are not ASCII".to_owned(),
+        other => other.to_string(),
+    }
+}
+
 /// A sentence the reader uses, parsed from `l` (line `line`): `Ok(None)` for the types
 /// it ignores, `Err(reason)` for a bad one.
 fn parse_sentence(line: u64, l: &str) -> Result<Option<Sentence>, String> {
@@ -184,7 +201,7 @@ fn parse_sentence(line: u64, l: &str) -> Result<Option<Sentence>, String> {
         return Ok(None);
     }
     let f = |x: Option<f32>| x.map(f64::from);
-    let (tod, data) = match ::nmea::parse_str(l).map_err(|e| e.to_string())? {
+    let (tod, data) = match ::nmea::parse_str(l).map_err(|e| bad_sentence(&e))? {
         ParseResult::GGA(g) => (
             g.fix_time,
             Data::Gga(Gga {
