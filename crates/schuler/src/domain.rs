@@ -49,7 +49,16 @@ fn number(v: f64) -> String {
 impl fmt::Display for DomainError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let d = &self.domain;
-        let show = |v: f64| number(v / d.scale);
+        // A finite SI value beyond the display unit's range (1e308 rad/s in deg/s)
+        // prints as a bound, never as `inf`.
+        let show = |v: f64| {
+            let u = v / d.scale;
+            if u.is_finite() || !v.is_finite() {
+                number(u)
+            } else {
+                format!("{}1.8e308", if u < 0.0 { "below -" } else { "above " })
+            }
+        };
         // A lower bound of the smallest positive number reads as an open 0.
         let lower = if d.min == f64::MIN_POSITIVE {
             "(0".to_owned()
