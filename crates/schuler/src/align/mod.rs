@@ -152,22 +152,31 @@ impl fmt::Display for AlignError {
                 threshold,
                 heading_change,
                 moving,
-            } => write!(
-                f,
-                "the fine stage moved the coarse attitude by {:.3} deg of heading, {:.1} \
-                 standard deviations (chi-square {chi2:.1} on {dof} degrees of freedom, \
-                 threshold {threshold:.1}): its own stages contradict each other, so no \
-                 heading is given. {}",
-                heading_change.to_degrees(),
-                chi2.sqrt(),
-                if *moving {
-                    "The base moved (motion detected): align at rest, or in motion with GNSS"
+            } => {
+                if chi2.is_finite() && heading_change.is_finite() {
+                    write!(
+                        f,
+                        "the fine stage moved the coarse attitude by {:.3} deg of heading, \
+                         {:.1} standard deviations (chi-square {chi2:.1} on {dof} degrees of \
+                         freedom, threshold {threshold:.1})",
+                        heading_change.to_degrees(),
+                        chi2.sqrt()
+                    )?;
                 } else {
-                    "The log does not behave as a base at rest with this noise model: \
+                    write!(f, "the fine stage's filter left the finite numbers")?;
+                }
+                write!(
+                    f,
+                    ": its own stages contradict each other, so no heading is given. {}",
+                    if *moving {
+                        "The base moved (motion detected): align at rest, or in motion with GNSS"
+                    } else {
+                        "The log does not behave as a base at rest with this noise model: \
                      columns swapped or units wrong (--imu-columns, --gyro-unit), or the \
                      noise model far too optimistic (--imu-grade)"
-                }
-            ),
+                    }
+                )
+            }
         }
     }
 }
@@ -226,12 +235,18 @@ pub const CONSISTENCY_PROBABILITY: f64 = 1.0 - 1e-6;
 /// consistent linear filter the estimate `δ` and its error are uncorrelated, so
 /// `cov δ = P₀ − P₁` (`P₁` the posterior) and `δᵀ (P₀ − P₁)⁺ δ` is chi-square with
 /// the rank of `P₀ − P₁` degrees of freedom (Bar-Shalom, Li & Kirubarajan 2001,
-/// §5.4: the same logic as the innovation test). Returns `(statistic, dof)`.
+/// §5.4: the same logic as the innovation test). Returns `(statistic, dof)`; a NaN
+/// statistic when an input is not finite.
 pub fn coarse_consistency(
     delta: &Vector3<f64>,
     prior: &Matrix3<f64>,
     posterior: &Matrix3<f64>,
 ) -> (f64, usize) {
+    let inputs = delta.iter().chain(prior.iter()).chain(posterior.iter());
+    if !inputs.into_iter().all(|x| x.is_finite()) {
+        // A filter driven out of the numbers contradicts everything.
+        return (f64::NAN, 3);
+    }
     let d = (prior - posterior).symmetric_eigen();
     let largest = d.eigenvalues.max().max(0.0);
     let mut chi2 = 0.0;
@@ -442,7 +457,7 @@ pub fn align<E: EarthModel>(
         &p.fixed_view::<3, 3>(r_ref, r_ref).into_owned(),
     );
     let threshold = crate::filter::kalman::chi_square_quantile(dof, CONSISTENCY_PROBABILITY);
-    if chi2 > threshold {
+    if !(chi2 <= threshold) {
         return Err(AlignError::Inconsistent {
             chi2,
             dof,
