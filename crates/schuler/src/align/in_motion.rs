@@ -448,7 +448,7 @@ pub fn start_at_fix<E: EarthModel>(
     }
     // The tilts are the specific force's direction taken as gravity's: with the
     // acceleration near g they are unknown (a standard deviation beyond 45 deg).
-    if !(accel < local.g_n.z) {
+    if accel.is_nan() || accel >= local.g_n.z {
         return Err(implausible(format!(
             "an acceleration of {:.1} m/s^2 with a velocity uncertain by {sigma_v:.1} m/s \
              (together more than g: no tilt can be taken from the accelerometers)",

@@ -457,7 +457,7 @@ pub fn align<E: EarthModel>(
         &p.fixed_view::<3, 3>(r_ref, r_ref).into_owned(),
     );
     let threshold = crate::filter::kalman::chi_square_quantile(dof, CONSISTENCY_PROBABILITY);
-    if !(chi2 <= threshold) {
+    if chi2.is_nan() || chi2 > threshold {
         return Err(AlignError::Inconsistent {
             chi2,
             dof,

@@ -125,10 +125,10 @@ impl ChannelConfig {
     fn held_down(&self) -> Result<(), ChannelError> {
         let truth = self.truth();
         let ends = self.speed.changes.iter().map(|c| c.start + c.duration);
-        let Some(t) = std::iter::once(0.0)
-            .chain(ends)
-            .find(|&t| !(truth.specific_force(t).0 > 0.0))
-        else {
+        let Some(t) = std::iter::once(0.0).chain(ends).find(|&t| {
+            let f = truth.specific_force(t).0;
+            f.is_nan() || f <= 0.0
+        }) else {
             return Ok(());
         };
         let (a, w) = (self.earth.radius, self.earth.rotation_rate);
