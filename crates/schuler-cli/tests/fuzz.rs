@@ -340,19 +340,58 @@ fn rtklib_log(path: &Path, bytes: &[u8]) -> Result<bool, String> {
 }
 
 fn nav_log(path: &Path, _: &[u8]) -> Result<bool, String> {
+    // Every column in its domain (issue 36: a height of 1.8e308 or a longitude of
+    // 7680 deg was accepted); the seeds hold simulate's truth.csv (time named `t`).
     judged(path, nav::read_nav(path), |(_, rows)| {
         rows.iter().try_for_each(|r| {
-            finite("time", &[r.t_sow])?;
+            in_domain(&domain::TIME, r.t_sow)?;
             in_domain(&domain::LATITUDE, r.pos.lat)?;
-            finite("position", &[r.pos.lon, r.pos.h])?;
-            finite("velocity", r.v_n.as_slice())?;
+            in_domain(&domain::LONGITUDE_WRAPPED, r.pos.lon)?;
+            in_domain(&domain::HEIGHT, r.pos.h)?;
+            r.v_n
+                .iter()
+                .try_for_each(|v| in_domain(&domain::SPEED, *v))?;
             finite("attitude", &[r.att.roll, r.att.pitch, r.att.yaw])
         })
     })
 }
 
-fn baro(path: &Path, _: &[u8]) -> Result<bool, String> {
+/// An accepted barometer CSV read its columns by unique names, every row as wide as
+/// its header (issue 36: `t,t,h_m,outlier` and a header wider than its rows were read
+/// from the wrong column).
+fn baro_header_kept(bytes: &[u8]) -> Result<(), String> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut lines = text
+        .lines()
+        .map(|l| l.trim_start_matches('\u{feff}').trim())
+        .filter(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with('%'));
+    let Some(header) = lines.next() else {
+        return Ok(());
+    };
+    let first = header.split([',', ';', ' ', '\t']).next().unwrap_or("");
+    if first.parse::<f64>().is_ok() {
+        return Ok(());
+    }
+    let names: Vec<String> = header.split(',').map(|n| n.trim().to_lowercase()).collect();
+    for group in [
+        &["t", "time", "timestamp"][..],
+        &["h_m", "h", "height", "height_m", "alt", "altitude"],
+    ] {
+        if names.iter().filter(|n| group.contains(&n.as_str())).count() > 1 {
+            return Err(format!("accepted a header naming a column twice: {header}"));
+        }
+    }
+    match lines.find(|l| header.contains(',') && l.split(',').count() != names.len()) {
+        Some(row) => Err(format!(
+            "accepted a row of another width than `{header}`: {row}"
+        )),
+        None => Ok(()),
+    }
+}
+
+fn baro(path: &Path, bytes: &[u8]) -> Result<bool, String> {
     judged(path, read_baro(path), |rows| {
+        baro_header_kept(bytes)?;
         rows.iter().try_for_each(|(t, h)| {
             finite("time", &[*t])?;
             in_domain(&domain::HEIGHT, *h)
@@ -411,9 +450,17 @@ fn scenario(path: &Path, _: &[u8]) -> Result<bool, String> {
     judged(path, spec, |spec| {
         // The models and the motion must build or be refused, never panic; a
         // refusal here comes from the library and names the key.
-        let _ = spec.imu.model();
-        let _ = spec.gnss.as_ref().map(|g| g.model());
-        let _ = spec.baro.as_ref().map(|b| b.model());
+        // A model that builds has its sensor's rate in its domain (issue 36: a rate of
+        // 1e6 or 1e308 Hz grew memory without bound).
+        if spec.imu.model().is_ok() {
+            in_domain(&domain::IMU_RATE, spec.imu.rate_hz)?;
+        }
+        if let Some(g) = spec.gnss.as_ref().filter(|g| g.model().is_ok()) {
+            in_domain(&domain::GNSS_RATE, g.rate_hz)?;
+        }
+        if let Some(b) = spec.baro.as_ref().filter(|b| b.model().is_ok()) {
+            in_domain(&domain::AID_RATE, b.rate_hz)?;
+        }
         if let Ok(traj) = spec.trajectory(Wgs84) {
             let (t0, t1) = (traj.0.start(), traj.0.end());
             finite("trajectory span", &[t0, t1])?;
@@ -423,6 +470,19 @@ fn scenario(path: &Path, _: &[u8]) -> Result<bool, String> {
 }
 
 fn nav_config(path: &Path, _: &[u8]) -> Result<bool, String> {
+    // The files the seed names, beside the input: a configuration's paths must open
+    // (issue 36: an error then names the key), the files themselves are not read here.
+    let dir = path.parent().expect("folder").join("drive");
+    std::fs::create_dir_all(&dir).expect("create drive/");
+    for name in [
+        "imu.txt",
+        "gnss.txt",
+        "baro.csv",
+        "odometer.txt",
+        "rest.txt",
+    ] {
+        std::fs::write(dir.join(name), "").expect("write a named file");
+    }
     let args = schuler_run::nav::NavArgs {
         config: Some(path.to_path_buf()),
         ..Default::default()
@@ -721,6 +781,186 @@ fn the_session_reports_finite_epochs_or_an_error_on_random_samples() {
     }
     eprintln!(
         "fuzz session: {runs} runs, {samples} samples integrated, in {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// One start in motion on random fixes (issue 36: one fix, two, a log in reverse
+/// order, repeated times panicked or gave NaN): a level IMU at rest or turning, then
+/// 1 to 12 fixes along a random course, in time order, reversed or with a repeated
+/// time, and the pair `(i, j)` the start is asked for as `motion_start` asks it
+/// (`j` may equal `i` or lie past the last fix). `Err` on a panic or on a start
+/// holding a non-finite value.
+fn in_motion_run(rng: &mut Rng) -> Result<u64, String> {
+    use schuler::align::in_motion::{InMotionConfig, course_pair, start_at_fix, start_in_motion};
+    let turn = spread(rng, 0.5);
+    let samples: Vec<ImuSample> = (1..=2000)
+        .map(|k| ImuSample {
+            t: f64::from(k) * 0.01,
+            dt: 0.01,
+            dtheta: Vector3::new(0.0, 0.0, turn * 0.01),
+            dvel: Vector3::new(spread(rng, 1.0), spread(rng, 1.0), -9.8) * 0.01,
+        })
+        .collect();
+    let n = 1 + rng.below(12);
+    let (course, speed) = (spread(rng, std::f64::consts::PI), spread(rng, 50.0).abs());
+    let std = spread(rng, 1e3).abs().max(1e-3);
+    let mut fixes: Vec<GnssFix> = (0..n)
+        .map(|k| {
+            let t = 2.0 + k as f64;
+            let d = speed * (t - 2.0);
+            GnssFix {
+                t,
+                pos: Geodetic::new(
+                    0.786 + d * course.cos() / 6.37e6,
+                    0.134 + d * course.sin() / 4.5e6,
+                    245.0 + spread(rng, 10.0),
+                ),
+                pos_std: Vector3::repeat(std),
+                vel: None,
+            }
+        })
+        .collect();
+    match rng.below(4) {
+        0 => fixes.reverse(),
+        1 if n > 1 => fixes[n - 1].t = fixes[n - 2].t,
+        _ => {}
+    }
+    let cfg = InMotionConfig::default();
+    let (i, j) = (rng.below(n + 1), rng.below(n + 2));
+    let starts = [
+        start_in_motion(&Wgs84, &samples, &fixes, &cfg),
+        start_at_fix(&Wgs84, &samples, &fixes, i, j, &cfg),
+        course_pair(&Wgs84, &fixes, &cfg)
+            .and_then(|(i, j)| start_at_fix(&Wgs84, &samples, &fixes, i, j, &cfg)),
+    ];
+    let mut made = 0;
+    for s in starts.into_iter().flatten() {
+        let p = &s.state;
+        let q = p.q_bn.as_ref();
+        finite(
+            "start",
+            &[
+                p.t, p.pos.lat, p.pos.lon, p.pos.h, q.w, q.i, q.j, q.k, s.speed,
+            ],
+        )?;
+        finite("start velocity", p.v_n.as_slice())?;
+        for (what, v) in [
+            ("pos_std", &s.pos_std),
+            ("vel_std", &s.vel_std),
+            ("att_std", &s.att_std),
+        ] {
+            if !v.iter().all(|x| x.is_finite() && *x > 0.0) {
+                return Err(format!("{what} {v:?} of a start from {n} fixes"));
+            }
+        }
+        made += 1;
+    }
+    Ok(made)
+}
+
+#[test]
+fn in_motion_starts_are_finite_or_refused_on_random_fixes() {
+    let (limit, seed) = budget();
+    let mut rng = Rng(seed ^ 0x1A_0710);
+    let (start, mut runs, mut made) = (Instant::now(), 0u64, 0u64);
+    let mut failures = Vec::new();
+    while more(limit, start, runs) {
+        let state = rng.0;
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| in_motion_run(&mut rng))) {
+            Ok(Ok(n)) => made += n,
+            Ok(Err(e)) => failures.push(format!("stream state {state:#x}: {e}")),
+            Err(_) => failures.push(format!("stream state {state:#x}: panicked")),
+        }
+        runs += 1;
+        if failures.len() >= 5 {
+            break;
+        }
+    }
+    eprintln!(
+        "fuzz in_motion: {runs} runs, {made} starts made, the others refused, in {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// One alignment of a log that turns at a random constant rate about a random axis
+/// (issue 36: a log turning at 10 deg/s gave a confident wrong heading): 30 s coarse
+/// and 60 s fine at 50 Hz, the navigation-grade noise model. No panic; an alignment
+/// made is finite; a turn beyond 1 deg/s about a horizontal axis (the gyros tilt the
+/// base by 90 deg while the accelerometers stay level: not a base at rest) is refused.
+fn align_run(rng: &mut Rng) -> Result<bool, String> {
+    use schuler::align::{AlignConfig, align};
+    let axis = Vector3::new(spread(rng, 1.0), spread(rng, 1.0), spread(rng, 1.0));
+    let axis = axis.try_normalize(1e-9).unwrap_or(Vector3::z());
+    let rate = spread(rng, 20f64.to_radians()).abs();
+    let w_earth = Vector3::new(5.2e-5, 0.0, -5.2e-5);
+    let samples: Vec<ImuSample> = (1..=4500)
+        .map(|k| ImuSample {
+            t: f64::from(k) * 0.02,
+            dt: 0.02,
+            dtheta: (w_earth + axis * rate) * 0.02,
+            dvel: Vector3::new(spread(rng, 1e-3), spread(rng, 1e-3), -9.8) * 0.02,
+        })
+        .collect();
+    let noise = ImuNoise::from_model(
+        &schuler::sim::sensor_spec::ImuSpec::of_preset(
+            50.0,
+            schuler::sim::sensor_spec::Preset::Navigation,
+        )
+        .model()
+        .map_err(|e| e.to_string())?,
+    );
+    let cfg = AlignConfig {
+        coarse: 30.0,
+        fine: 60.0,
+        max_heading_std: std::f64::consts::PI,
+        ..AlignConfig::default()
+    };
+    let pos = Geodetic::new(45f64.to_radians(), 0.1, 100.0);
+    let Ok(a) = align(Wgs84, pos, &samples, &noise, &cfg) else {
+        return Ok(false);
+    };
+    let q = a.state.q_bn.as_ref();
+    finite("aligned attitude", &[q.w, q.i, q.j, q.k])?;
+    finite("attitude std", a.attitude_std.as_slice())?;
+    let horizontal = (axis * rate).xy().norm();
+    if horizontal > 1f64.to_radians() {
+        return Err(format!(
+            "aligned a base turning at {:.2} deg/s about a horizontal axis: yaw {:.2} ± {:.3} deg",
+            horizontal.to_degrees(),
+            a.state.euler().yaw.to_degrees(),
+            a.attitude_std.z.to_degrees()
+        ));
+    }
+    Ok(true)
+}
+
+#[test]
+fn align_refuses_or_stays_finite_on_turning_logs() {
+    let (limit, seed) = budget();
+    let mut rng = Rng(seed ^ 0x000A_116E);
+    let (start, mut runs, mut aligned) = (Instant::now(), 0u64, 0u64);
+    let mut failures = Vec::new();
+    // An alignment is costlier than a parse: a tenth of the parsers' inputs.
+    while match limit {
+        Some(d) => start.elapsed() < d,
+        None => runs < DEFAULT_RUNS / 10,
+    } {
+        let state = rng.0;
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| align_run(&mut rng))) {
+            Ok(Ok(a)) => aligned += u64::from(a),
+            Ok(Err(e)) => failures.push(format!("stream state {state:#x}: {e}")),
+            Err(_) => failures.push(format!("stream state {state:#x}: panicked")),
+        }
+        runs += 1;
+        if failures.len() >= 5 {
+            break;
+        }
+    }
+    eprintln!(
+        "fuzz align: {runs} turning logs, {aligned} aligned, the others refused, in {:.1} s",
         start.elapsed().as_secs_f64()
     );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
