@@ -55,6 +55,7 @@ fn setup(rate_hz: f64) -> (NavSettings, Aiding) {
     let noise = ImuNoise::from_model(&spec.model().expect("preset"));
     let settings = common::settings(imu, dir.join("out"));
     let aiding = Aiding {
+        raw: None,
         fixes: fixes.into(),
         filter: FilterConfig::new(IntegrationConfig {
             noise,

@@ -87,18 +87,28 @@ pub struct Summary {
 
 /// The solver's configuration from `args`, checked against the systems of `store`.
 pub fn config(args: &Args, store: &EphemerisStore) -> Result<SppConfig> {
-    let mut c = SppConfig {
+    let c = SppConfig {
         elevation_mask: args.elevation_mask.to_radians(),
         ionosphere: !args.no_iono,
         troposphere: !args.no_tropo,
         ..SppConfig::default()
     };
+    with_systems(c, &args.systems, store)
+}
+
+/// `c` using the systems of `systems` (RINEX letters; empty: every one with
+/// ephemerides in `store`), checked.
+pub(crate) fn with_systems(
+    mut c: SppConfig,
+    systems: &[char],
+    store: &EphemerisStore,
+) -> Result<SppConfig> {
     let with_eph: Vec<System> = store.sats().map(|s| s.system).collect();
-    if args.systems.is_empty() {
+    if systems.is_empty() {
         c.signals.retain(|(s, _)| with_eph.contains(s));
     } else {
         let mut wanted = Vec::new();
-        for &l in &args.systems {
+        for &l in systems {
             let Some(s) = System::from_letter(l.to_ascii_uppercase()).filter(|_| l != ' ') else {
                 bail!("--systems: unknown system letter `{l}` (G, E, C, J)");
             };
@@ -114,7 +124,7 @@ pub fn config(args: &Args, store: &EphemerisStore) -> Result<SppConfig> {
 }
 
 /// Reads every navigation file into one store.
-fn read_nav_files(paths: &[PathBuf]) -> Result<(EphemerisStore, Option<Klobuchar>)> {
+pub(crate) fn read_nav_files(paths: &[PathBuf]) -> Result<(EphemerisStore, Option<Klobuchar>)> {
     let mut store = EphemerisStore::new();
     let mut klobuchar = None;
     for p in paths {

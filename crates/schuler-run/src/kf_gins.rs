@@ -194,6 +194,7 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
         out_bag: None,
     };
     let aiding = Aiding {
+        raw: None,
         fixes: fixes.closed(),
         filter: FilterConfig::new(integration(
             &y,

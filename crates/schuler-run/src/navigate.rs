@@ -107,6 +107,9 @@ fn new_session<E: EarthModel>(
 ) -> Result<Session<E>> {
     let mut session =
         Session::new(earth, settings.session_config(aiding), start).map_err(named_flag)?;
+    if let Some(r) = aiding.and_then(|a| a.raw.as_ref()) {
+        session = session.with_tight(r.tight.clone()).map_err(named_flag)?;
+    }
     if let Some(rows) = aiding.and_then(|a| a.report.truth.as_ref()?.held.clone()) {
         session = session.with_truth(rows);
     }
@@ -128,6 +131,11 @@ pub fn open_session<E: EarthModel>(
         }
         for aid in aids(a) {
             session.push(aid)?;
+        }
+        if let Some(r) = &a.raw {
+            for aid in r.read_aids()? {
+                session.push(aid)?;
+            }
         }
     }
     Ok(session)
@@ -412,6 +420,12 @@ where
     let mut bank = HeadingBank::new(earth, config, start, members)
         .map_err(named_flag)?
         .with_truth(&aiding.report.truth_records()?);
+    if aiding.raw.is_some() {
+        bail!(
+            "--init gnss-any-heading takes its heading from GNSS fixes (--gnss); raw \
+             observations (--gnss-obs) cannot start it yet: give --init-att"
+        );
+    }
     for aid in aids(aiding) {
         bank.push(aid)?;
     }

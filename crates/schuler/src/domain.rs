@@ -142,6 +142,30 @@ pub const SPEED: Domain = Domain {
     why: "faster than the Earth's escape velocity",
 };
 
+/// A pseudorange [m]: a satellite of any system is 19 000–42 000 km from a receiver
+/// on or near the Earth, plus the receiver clock's bias (within a few ms when it is
+/// not steered); 100 km to 100 000 km holds every one.
+pub const PSEUDORANGE: Domain = Domain {
+    quantity: "pseudorange",
+    min: 1e5,
+    max: 1e8,
+    unit: "m",
+    scale: 1.0,
+    why: "no satellite signal travels less than 100 km or more than 1e5 km",
+};
+
+/// A pseudorange rate [m/s]: a satellite's line-of-sight speed (below 1 km/s) plus
+/// the receiver oscillator's frequency offset (c·1 ppm = 300 m/s); ±100 km/s is 300
+/// ppm, beyond any oscillator that still tracks.
+pub const RANGE_RATE: Domain = Domain {
+    quantity: "pseudorange rate",
+    min: -1e5,
+    max: 1e5,
+    unit: "m/s",
+    scale: 1.0,
+    why: "beyond 300 ppm of oscillator offset",
+};
+
 /// Angular rate magnitude a gyro can report [rad/s]: MEMS gyros end at 4000-6000
 /// deg/s; 20 000 deg/s (55 turns a second) covers spin-stabilised projectiles' sensors.
 pub const ANGULAR_RATE: Domain = Domain {

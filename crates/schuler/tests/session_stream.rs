@@ -100,7 +100,7 @@ fn run(noise: ImuNoise, start: Start, window: f64, inputs: &[Input]) -> Run {
     for input in inputs {
         match input {
             Input::Imu(x) => s.push_imu(*x).expect("samples in order"),
-            Input::Aid(a) => s.push(*a).expect("finite aid"),
+            Input::Aid(a) => s.push(a.clone()).expect("finite aid"),
         }
         epochs.extend(s.epochs());
         events.extend(s.events());
@@ -115,7 +115,7 @@ fn run(noise: ImuNoise, start: Start, window: f64, inputs: &[Input]) -> Run {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 enum Input {
     Imu(ImuSample),
     Aid(Aid),
@@ -123,7 +123,7 @@ enum Input {
 
 /// The batch order: every aid first, then the samples.
 fn batch(log: &Log) -> Vec<Input> {
-    let aids = log.aids.iter().map(|a| Input::Aid(*a));
+    let aids = log.aids.iter().map(|a| Input::Aid(a.clone()));
     aids.chain(log.imu.iter().map(|s| Input::Imu(*s))).collect()
 }
 
@@ -135,9 +135,9 @@ fn jittered(log: &Log, seed: u64, extra: &[(f64, Aid)]) -> Vec<Input> {
     timed.extend(
         log.aids
             .iter()
-            .map(|a| (a.t() + rng.uniform() - 0.5, Input::Aid(*a))),
+            .map(|a| (a.t() + rng.uniform() - 0.5, Input::Aid(a.clone()))),
     );
-    timed.extend(extra.iter().map(|&(at, a)| (at, Input::Aid(a))));
+    timed.extend(extra.iter().map(|(at, a)| (*at, Input::Aid(a.clone()))));
     timed.sort_by(|a, b| a.0.total_cmp(&b.0));
     timed.into_iter().map(|x| x.1).collect()
 }
@@ -252,7 +252,7 @@ fn bad_input_is_refused_with_its_reason() {
 fn aids_the_configuration_cannot_use_are_reported() {
     let log = log();
     let mut s = Session::new(Wgs84, SessionConfig::default(), log.start).expect("free");
-    s.push(log.aids[0]).expect("finite");
+    s.push(log.aids[0].clone()).expect("finite");
     let events: Vec<Event> = s.events().collect();
     assert!(
         matches!(events.as_slice(), [Event::Ignored { reason, .. }] if reason.contains("filter")),
@@ -317,12 +317,12 @@ fn the_gate_reset_refuses_impossible_fixes() {
                     f.pos.lat += jump / 6_378_137.0;
                     Aid::Gnss(f)
                 }
-                other => *other,
+                other => other.clone(),
             })
             .collect();
         let inputs: Vec<Input> = aids
             .iter()
-            .map(|a| Input::Aid(*a))
+            .map(|a| Input::Aid(a.clone()))
             .chain(log.imu.iter().map(|s| Input::Imu(*s)))
             .collect();
         run(log.noise, log.start, 0.0, &inputs)
@@ -376,8 +376,8 @@ fn a_streamed_truth_gives_the_snapshots_of_the_whole_truth() {
     let mut whole = new().with_truth(truth.clone());
     let mut streamed = new();
     for a in &log.aids {
-        whole.push(*a).expect("aid");
-        streamed.push(*a).expect("aid");
+        whole.push(a.clone()).expect("aid");
+        streamed.push(a.clone()).expect("aid");
     }
     let (mut next, mut taken): (usize, Vec<Snapshot>) = (0, Vec::new());
     for s in &log.imu {

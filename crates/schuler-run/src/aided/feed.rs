@@ -47,6 +47,9 @@ pub struct AidFeed<'a> {
     pushed: usize,
     /// The fixes' store, checked at the end (a read that failed ends its iteration).
     fixes: Option<&'a super::fixes::Fixes>,
+    /// The raw GNSS stream, whose read error ([`super::raw_gnss::RawGnss::aids`]) is
+    /// checked after the first pass and at the end.
+    raw: Option<&'a super::raw_gnss::RawGnss>,
 }
 
 impl<'a> AidFeed<'a> {
@@ -61,6 +64,7 @@ impl<'a> AidFeed<'a> {
             truth_until: f64::INFINITY,
             pushed: 0,
             fixes: None,
+            raw: None,
         }
     }
 
@@ -69,7 +73,7 @@ impl<'a> AidFeed<'a> {
     /// kinds not in time order are pushed now.
     pub fn open<E: EarthModel>(a: &'a Aiding, session: &mut Session<E>) -> Result<Self> {
         let v = &a.vehicle;
-        let kinds: [Kind<'a>; 5] = [
+        let kinds: [Kind<'a>; 6] = [
             Box::new(|| Box::new(a.fixes.iter().map(Aid::Gnss))),
             Box::new(|| Box::new(a.baro.iter().map(|&(t, h)| Aid::Baro { t, h }))),
             Box::new(|| Box::new(v.rests.iter().map(|&(t0, t1)| Aid::Rest { t0, t1 }))),
@@ -81,6 +85,10 @@ impl<'a> AidFeed<'a> {
                 )
             }),
             Box::new(|| Box::new(v.headings.iter().map(|&h| Aid::Heading(h)))),
+            Box::new(move || match &a.raw {
+                Some(r) => r.aids(),
+                None => Box::new(std::iter::empty()),
+            }),
         ];
         let mut sources = Vec::new();
         for kind in kinds {
@@ -91,6 +99,9 @@ impl<'a> AidFeed<'a> {
                 aid.validate()?;
                 sorted &= last <= aid.t();
                 last = aid.t();
+            }
+            if let Some(e) = a.raw.as_ref().and_then(|r| r.take_error()) {
+                return Err(e);
             }
             if sorted {
                 sources.push(kind().peekable());
@@ -117,6 +128,7 @@ impl<'a> AidFeed<'a> {
             truth,
             pushed: 0,
             fixes: Some(&a.fixes),
+            raw: a.raw.as_ref(),
         };
         a.fixes.status()?;
         feed.push_until(session, f64::NEG_INFINITY)?;
@@ -192,6 +204,9 @@ impl<'a> AidFeed<'a> {
     pub fn rest<E: EarthModel>(&mut self, session: &mut Session<E>) -> Result<()> {
         self.push_until(session, f64::INFINITY)?;
         self.sources.clear();
+        if let Some(e) = self.raw.and_then(|r| r.take_error()) {
+            return Err(e);
+        }
         self.fixes.map_or(Ok(()), super::fixes::Fixes::status)
     }
 }
@@ -256,6 +271,7 @@ mod tests {
             baro,
             report: ReportSettings::default(),
             vehicle: Default::default(),
+            raw: None,
         }
     }
 

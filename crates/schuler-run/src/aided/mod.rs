@@ -6,6 +6,7 @@
 
 pub mod feed;
 pub mod fixes;
+pub mod raw_gnss;
 pub mod record;
 pub mod refusals;
 pub mod report;
@@ -88,6 +89,8 @@ pub struct Aiding {
     pub report: ReportSettings,
     /// Rest intervals, odometer and heading readings.
     pub vehicle: VehicleReadings,
+    /// Raw GNSS for tight coupling (`--gnss-obs`).
+    pub raw: Option<raw_gnss::RawGnss>,
 }
 
 /// Aiding readings held in memory, in place of the files of `--gnss`, `--baro` and the
@@ -160,6 +163,24 @@ pub struct AidingOptions {
     #[arg(long, allow_hyphen_values = true, value_name = "SPEED")]
     #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
     pub gnss_vel_std: Option<String>,
+    /// RINEX observation file (2.xx, 3.0x, 4.0x; gzip or Hatanaka): tight coupling,
+    /// each pseudorange and Doppler a measurement of the filter, whose state gains the
+    /// receiver clock (needs --gnss-nav; not with --gnss).
+    #[arg(long, allow_hyphen_values = true, value_name = "OBS")]
+    pub gnss_obs: Option<PathBuf>,
+    /// RINEX navigation file(s) of broadcast ephemerides for --gnss-obs (repeat for
+    /// several).
+    #[arg(long, allow_hyphen_values = true, value_name = "NAV")]
+    #[serde(default)]
+    pub gnss_nav: Vec<PathBuf>,
+    /// Elevation mask of --gnss-obs [deg] (default 10).
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub elevation_mask: Option<f64>,
+    /// Systems of --gnss-obs used, by RINEX letter (`G,E,C,J`; default every one with
+    /// ephemerides).
+    #[arg(long, value_delimiter = ',', value_name = "G,E,C")]
+    #[serde(default)]
+    pub gnss_systems: Vec<char>,
     /// Antenna position in body axes, front, right, down [m].
     #[arg(
         long,
@@ -379,10 +400,12 @@ impl AidingOptions {
     /// `self` with missing fields taken from `other`.
     pub fn or(self, other: AidingOptions) -> AidingOptions {
         macro_rules! pick {
-            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth, no_report: self.no_report || other.no_report, zupt_detect: self.zupt_detect || other.zupt_detect, zaru: self.zaru || other.zaru, nhc: self.nhc || other.nhc } };
+            ($($f:ident),*) => { AidingOptions { $($f: self.$f.or(other.$f),)* gnss_nav: if self.gnss_nav.is_empty() { other.gnss_nav } else { self.gnss_nav }, gnss_systems: if self.gnss_systems.is_empty() { other.gnss_systems } else { self.gnss_systems }, scale_factors: self.scale_factors || other.scale_factors, smooth: self.smooth || other.smooth, no_report: self.no_report || other.no_report, zupt_detect: self.zupt_detect || other.zupt_detect, zaru: self.zaru || other.zaru, nhc: self.nhc || other.nhc } };
         }
         pick!(
             gnss,
+            gnss_obs,
+            elevation_mask,
             gnss_format,
             gnss_std,
             gnss_min_quality,
@@ -436,8 +459,14 @@ impl AidingOptions {
 
     /// Paths relative to `base` (a config file's folder).
     pub fn relative_to(mut self, base: &Path) -> Self {
+        for p in self.gnss_nav.iter_mut() {
+            if p.is_relative() {
+                *p = base.join(&*p);
+            }
+        }
         for p in [
             &mut self.gnss,
+            &mut self.gnss_obs,
             &mut self.gnss_vel,
             &mut self.truth,
             &mut self.sensor_truth,
@@ -476,6 +505,7 @@ impl AidingOptions {
     /// Whether any aiding source is given (GNSS, barometer or a vehicle aid).
     pub fn any(&self) -> bool {
         self.gnss.is_some()
+            || self.gnss_obs.is_some()
             || self
                 .bag
                 .as_ref()
@@ -531,6 +561,7 @@ impl AidingOptions {
             }
             return Ok(None);
         }
+        let raw = self.raw_gnss(has_gnss)?;
         let (fixes, outage_test) = self.fix_store(given.fixes)?;
         let noise = self.noise(noise)?;
         let (baro, baro_std) = self.baro(given.baro)?;
@@ -554,7 +585,33 @@ impl AidingOptions {
             baro,
             report: self.report()?,
             fixes,
+            raw,
         }))
+    }
+
+    /// The raw GNSS of `--gnss-obs` (`has_fixes`: fixes are given too, refused).
+    fn raw_gnss(&self, has_fixes: bool) -> Result<Option<raw_gnss::RawGnss>> {
+        let Some(obs) = &self.gnss_obs else {
+            if !self.gnss_nav.is_empty() {
+                bail!("--gnss-nav serves --gnss-obs (tight coupling): give --gnss-obs OBS");
+            }
+            return Ok(None);
+        };
+        if has_fixes {
+            bail!(
+                "--gnss and --gnss-obs are two views of one receiver (its fixes and its raw \
+                 measurements): give one"
+            );
+        }
+        let offset = self.gnss_time_offset()?.unwrap_or(0.0);
+        let raw = raw_gnss::RawGnss::open(
+            obs,
+            &self.gnss_nav,
+            self.elevation_mask.unwrap_or(10.0),
+            &self.gnss_systems,
+            offset,
+        )?;
+        Ok(Some(raw))
     }
 
     /// How `--gnss` is read, with `vel_std` [m/s] for velocities given without one.

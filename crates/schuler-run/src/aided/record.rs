@@ -81,7 +81,7 @@ impl InnovationRow {
 }
 
 /// The measurement kinds in the order of their code in a stored [`InnovationRow`].
-const KINDS: [Kind; 8] = [
+const KINDS: [Kind; 10] = [
     Kind::GnssPosition,
     Kind::GnssVelocity,
     Kind::BaroHeight,
@@ -90,6 +90,8 @@ const KINDS: [Kind; 8] = [
     Kind::NonHolonomic,
     Kind::Odometer,
     Kind::Heading,
+    Kind::Pseudorange,
+    Kind::RangeRate,
 ];
 
 /// The code of `kind` in [`KINDS`].
@@ -103,6 +105,8 @@ fn kind_code(kind: Kind) -> usize {
         Kind::NonHolonomic => 5,
         Kind::Odometer => 6,
         Kind::Heading => 7,
+        Kind::Pseudorange => 8,
+        Kind::RangeRate => 9,
     }
 }
 
@@ -272,6 +276,7 @@ mod tests {
         let baro = Innovation {
             t: 12.5,
             kind: Kind::BaroHeight,
+            sat: None,
             z: DVector::from_element(1, -0.25),
             s_diag: DVector::from_element(1, 0.0625),
             nis: 1.0,
@@ -282,6 +287,7 @@ mod tests {
         let pos = Innovation {
             t: 13.0,
             kind: Kind::GnssPosition,
+            sat: None,
             z: DVector::from_column_slice(&[1.0, -2.0, 0.5]),
             s_diag: DVector::from_column_slice(&[4.0, 9.0, 0.25]),
             nis: 1.5,

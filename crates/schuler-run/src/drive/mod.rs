@@ -238,7 +238,11 @@ impl Refusal {
         Some(match e {
             Event::Refused(x) => r(
                 x.t,
-                &x.kind,
+                // A range names its satellite: `pseudorange G05`.
+                &match x.sat {
+                    Some(sat) => format!("{} {sat}", x.kind),
+                    None => x.kind.to_string(),
+                },
                 "chi-square gate".into(),
                 Some(x.rejection.nis),
                 Some(x.rejection.threshold),
@@ -247,6 +251,7 @@ impl Refusal {
                 let why = match k.reason {
                     SkipReason::BeforeImu => "before the IMU data",
                     SkipReason::AfterImu => "after the IMU data",
+                    SkipReason::NotModelled => "not modelled by this error model",
                 };
                 r(k.t, &k.kind, why.into(), None, None)
             }
@@ -274,7 +279,7 @@ impl Refusal {
     }
 
     /// Its line of `rejected.csv`: `t,measurement,reason,nis,threshold` (empty fields
-    /// for what it lacks).
+    /// for what it lacks; a pseudorange or rate names its satellite in `measurement`).
     pub fn csv_line(&self) -> String {
         let opt = |x: Option<f64>| x.map(|x| x.to_string()).unwrap_or_default();
         format!(

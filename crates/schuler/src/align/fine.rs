@@ -123,6 +123,7 @@ pub fn fine_align<E: EarthModel>(
         noise: *noise,
         baro_bias_walk: 0.0,
         odometer_scale_walk: 0.0,
+        clock: Default::default(),
     };
     let r_ref = layout.attitude_ref.unwrap_or(15);
     let t0 = samples.first().map_or(0.0, |s| s.t - s.dt);

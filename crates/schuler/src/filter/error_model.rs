@@ -8,7 +8,11 @@
 //! - residual biases: random walks or Gauss–Markov, `ḃ = −b/τ + w` ([`super::noise`]);
 //!   scale factors, the baro bias, the odometer scale factor and
 //!   the reference attitude: constants (the baro bias and the odometer scale factor
-//!   with an optional walk).
+//!   with an optional walk);
+//! - receiver clock (tight coupling): `ḃ_s = d + w_b` for each system's bias and
+//!   `ḋ = w_d`, the two-state clock of Brown & Hwang (2012, §9.3), white `w_b`, `w_d`
+//!   of densities [`ClockNoise`], one `w_b` for every system (one oscillator: the
+//!   inter-system biases are constants).
 //!
 //! `ρ` is the transport rate of `c` (with zero vertical component in the wander frame),
 //! so nothing here is singular at a pole (Savage 2000, §12.2; Titterton & Weston 2004,
@@ -50,6 +54,43 @@ pub struct ErrorModel {
     pub baro_bias_walk: f64,
     /// Odometer scale-factor random-walk density [1/sqrt(s)].
     pub odometer_scale_walk: f64,
+    /// The receiver clock's noise, with clock states.
+    pub clock: ClockNoise,
+}
+
+/// The receiver clock's white-noise densities: `q_b` [m²/s] drives the biases,
+/// `q_d` [m²/s³] the drift. From an oscillator's Allan-variance coefficients
+/// `h₀`, `h₋₂`: `q_b = c²·h₀/2`, `q_d = c²·2π²·h₋₂` (Brown & Hwang 2012, §9.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClockNoise {
+    /// Bias density [m²/s].
+    pub q_b: f64,
+    /// Drift density [m²/s³].
+    pub q_d: f64,
+}
+
+impl ClockNoise {
+    /// From Allan-variance coefficients `h0` [s] and `h_2` [1/s].
+    pub fn from_allan(h0: f64, h_2: f64) -> Self {
+        let c2 = crate::gnss::C * crate::gnss::C;
+        Self {
+            q_b: c2 * h0 / 2.0,
+            q_d: c2 * 2.0 * std::f64::consts::PI.powi(2) * h_2,
+        }
+    }
+
+    /// A temperature-compensated crystal (TCXO), the oscillator of most receivers and
+    /// phones: h₀ = 2e-19 s, h₋₂ = 2e-20 /s (Brown & Hwang 2012, Table 9.1), so
+    /// q_b ≈ 9.0e-3 m²/s, q_d ≈ 3.6e-2 m²/s³.
+    pub fn tcxo() -> Self {
+        Self::from_allan(2e-19, 2e-20)
+    }
+}
+
+impl Default for ClockNoise {
+    fn default() -> Self {
+        Self::tcxo()
+    }
 }
 
 fn put(m: &mut DMatrix<f64>, r: usize, c: usize, b: &Matrix3<f64>) {
@@ -93,6 +134,11 @@ impl ErrorModel {
         if let Some(sa) = l.accel_scale {
             put(&mut a, v, sa, &(c_bc * Matrix3::from_diagonal(&m.f_b)));
         }
+        if let (Some(b), Some(d)) = (l.clock, l.clock_drift()) {
+            for i in 0..l.clock_systems {
+                a[(b + i, d)] = 1.0;
+            }
+        }
         a
     }
 
@@ -131,6 +177,16 @@ impl ErrorModel {
         }
         if let Some(o) = l.odometer_scale {
             q[(o, o)] = self.odometer_scale_walk * self.odometer_scale_walk;
+        }
+        if let (Some(b), Some(d)) = (l.clock, l.clock_drift()) {
+            // One oscillator: its noise is the same in every system's bias (the
+            // inter-system biases, their differences, stay constant).
+            for i in 0..l.clock_systems {
+                for j in 0..l.clock_systems {
+                    q[(b + i, b + j)] = self.clock.q_b;
+                }
+            }
+            q[(d, d)] = self.clock.q_d;
         }
         if nz.scale_tau.is_finite() {
             // Gauss–Markov scale factors: density 2σ²/τ.

@@ -49,13 +49,14 @@ impl GateBook {
         }
     }
 
-    /// Records the outcome of the update of innovation `z` at `t` through the gate
-    /// [`GateBook::gate`] chose (`reset`); returns the update to feed back if it was
-    /// accepted.
+    /// Records the outcome of the update of innovation `z` at `t` (of satellite `sat`,
+    /// for a range) through the gate [`GateBook::gate`] chose (`reset`); returns the
+    /// update to feed back if it was accepted.
     pub fn record(
         &mut self,
         t: f64,
         kind: Kind,
+        sat: Option<crate::gnss::Sat>,
         z: DVector<f64>,
         reset: bool,
         outcome: Result<Update, Rejection>,
@@ -68,6 +69,7 @@ impl GateBook {
         self.innovations.push(Innovation {
             t,
             kind,
+            sat,
             z,
             s_diag: s_diag.clone(),
             nis,
@@ -89,7 +91,12 @@ impl GateBook {
                     self.consecutive_rejections += 1;
                 }
                 self.counts.rejected += 1;
-                self.rejected.push(Rejected { t, kind, rejection });
+                self.rejected.push(Rejected {
+                    t,
+                    kind,
+                    sat,
+                    rejection,
+                });
                 None
             }
         }

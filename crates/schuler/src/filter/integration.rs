@@ -24,8 +24,10 @@ use super::kalman::{Gate, Kalman, Rejection};
 use super::layout::Layout;
 use super::measurement::{self, Kind, Measurement};
 use super::noise::ImuNoise;
+use super::ranging::{self, Tight, TightConfig};
 use super::vehicle::{self, Baseline, HeadingReading, VehicleMount};
 use crate::earth::{EarthModel, Geodetic};
+use crate::gnss::RangeEpoch;
 use crate::imu::ImuSample;
 use crate::nav::{ErrorFrame, NavErrors, NavState};
 use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, Vector3};
@@ -41,6 +43,37 @@ pub struct GnssFix {
     pub pos_std: Vector3<f64>,
     /// Velocity north, east, down [m/s] and its standard deviations, if measured.
     pub vel: Option<(Vector3<f64>, Vector3<f64>)>,
+}
+
+/// A GNSS measurement at one instant: a position (and velocity) fix, or one epoch of
+/// pseudoranges and rates for tight coupling.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GnssUpdate {
+    /// A fix (loose coupling).
+    Fix(GnssFix),
+    /// Raw ranges (tight coupling).
+    Ranges(Box<RangeEpoch>),
+}
+
+/// Something applied at its own time inside a sample ([`step_with_fixes`]).
+pub trait Timed {
+    /// Its time [s].
+    fn time(&self) -> f64;
+}
+
+impl Timed for GnssFix {
+    fn time(&self) -> f64 {
+        self.t
+    }
+}
+
+impl Timed for GnssUpdate {
+    fn time(&self) -> f64 {
+        match self {
+            GnssUpdate::Fix(f) => f.t,
+            GnssUpdate::Ranges(e) => e.t,
+        }
+    }
 }
 
 /// The gate's reset after consecutive refusals accepts a GNSS position only within
@@ -110,6 +143,8 @@ pub struct Rejected {
     pub t: f64,
     /// What it was.
     pub kind: Kind,
+    /// The satellite, for a pseudorange or a rate.
+    pub sat: Option<crate::gnss::Sat>,
     /// Why: the test's numbers.
     pub rejection: Rejection,
 }
@@ -125,6 +160,8 @@ pub struct Innovation {
     pub t: f64,
     /// What it was.
     pub kind: Kind,
+    /// The satellite, for a pseudorange or a rate.
+    pub sat: Option<crate::gnss::Sat>,
     /// Innovation (units of the measurement: m, m/s).
     pub z: DVector<f64>,
     /// Diagonal of the innovation covariance `S` (units squared).
@@ -153,6 +190,8 @@ pub enum SkipReason {
     BeforeImu,
     /// Its time is after the IMU data ended.
     AfterImu,
+    /// The filter has no model of it (range epochs in the 18-state filter).
+    NotModelled,
 }
 
 /// Estimated sensor errors (what the compensation removes).
@@ -207,6 +246,10 @@ pub struct Counts {
     pub odometer: u64,
     /// Accepted dual-antenna headings.
     pub heading: u64,
+    /// Accepted pseudoranges.
+    pub pseudorange: u64,
+    /// Accepted pseudorange rates.
+    pub range_rate: u64,
     /// Rejected by the gate.
     pub rejected: u64,
     /// Not usable (outside the IMU's time span).
@@ -225,6 +268,8 @@ impl Counts {
             Kind::NonHolonomic => &mut self.nhc,
             Kind::Odometer => &mut self.odometer,
             Kind::Heading => &mut self.heading,
+            Kind::Pseudorange => &mut self.pseudorange,
+            Kind::RangeRate => &mut self.range_rate,
         } += 1;
     }
 }
@@ -244,6 +289,8 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     pub book: GateBook,
     /// The record for the smoother, when smoothing.
     smoother: Option<super::smoother::SmootherLog>,
+    /// Tight coupling's settings, clock and counters, when it is on.
+    tight: Option<Box<Tight>>,
 }
 
 /// `c B cᵀ` of the 3x3 block `B` of `p` at `(o, o)`, element by element in the order of
@@ -274,6 +321,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             noise: cfg.noise,
             baro_bias_walk: baro_walk,
             odometer_scale_walk: 0.0,
+            clock: Default::default(),
         };
         let frame = mech.frame();
         let state = mech.state();
@@ -319,6 +367,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             w_ib_b: Vector3::zeros(),
             book: GateBook::default(),
             smoother: None,
+            tight: None,
         }
     }
 
@@ -391,6 +440,32 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             self = self.with_smoother();
         }
         self
+    }
+
+    /// Tight coupling under `cfg` ([`super::ranging`]): the receiver clock's biases
+    /// and drift appended to the layout (their variances set when the first
+    /// measurements start them; the smoother's record, if any, restarts).
+    pub fn with_tight(mut self, cfg: TightConfig) -> Self {
+        if self.tight.is_some() {
+            return self;
+        }
+        let old = self.model.layout.n;
+        self.model.layout = self.model.layout.with_clock(cfg.systems.len());
+        self.model.clock = cfg.clock;
+        let n = self.model.layout.n;
+        let mut p = DMatrix::zeros(n, n);
+        p.view_mut((0, 0), (old, old)).copy_from(&self.kf.p);
+        self.kf.p = p;
+        self.tight = Some(Box::new(Tight::new(cfg)));
+        if self.smoother.is_some() {
+            self = self.with_smoother();
+        }
+        self
+    }
+
+    /// Tight coupling's clock and counters, when it is on.
+    pub fn tight(&self) -> Option<&Tight> {
+        self.tight.as_deref()
     }
 
     /// Keep what the smoother needs (covariances, transitions, feedback, and the
@@ -500,7 +575,10 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 
     /// Mechanize a sample during which GNSS fixes may fall: fixes from `fixes` with
     /// times up to the sample's end are applied at their own times.
-    pub fn step_with_fixes<F: FixSource>(&mut self, raw: &ImuSample, fixes: &mut F) {
+    pub fn step_with_fixes<T, F: FixSource<T>>(&mut self, raw: &ImuSample, fixes: &mut F)
+    where
+        Self: FixConsumer<T>,
+    {
         step_with_fixes(self, raw, fixes);
     }
 
@@ -539,6 +617,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             w_ib_b: self.w_ib_b,
             book: self.book,
             smoother: self.smoother,
+            tight: self.tight,
         }
     }
 
@@ -585,7 +664,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     pub fn apply(&mut self, t: f64, m: Measurement) -> bool {
         let (gate, reset) = self.book.gate(&self.cfg, m.kind, m.z.len());
         let outcome = self.kf.update(&m.z, &m.h, &m.r, gate);
-        let Some(u) = self.book.record(t, m.kind, m.z, reset, outcome) else {
+        let Some(u) = self.book.record(t, m.kind, None, m.z, reset, outcome) else {
             return false;
         };
         self.feed_back(&u.dx);
@@ -620,6 +699,161 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if let Some(o) = l.mounting {
             self.estimates.mounting += Vector3::new(0.0, dx[o], dx[o + 1]);
         }
+        if let Some(t) = self.tight.as_mut() {
+            t.clocks.feed_back(&l, dx);
+        }
+    }
+
+    /// Apply one epoch of pseudoranges and rates now ([`super::ranging`]); ignored
+    /// without [`Integrator::with_tight`]. Returns how many measurements were accepted.
+    pub fn update_ranges(&mut self, e: &RangeEpoch) -> usize {
+        let Some(mut tight) = self.tight.take() else {
+            return 0;
+        };
+        let accepted = self.ranges_with(&mut tight, e);
+        self.tight = Some(tight);
+        accepted
+    }
+
+    fn ranges_with(&mut self, tight: &mut Tight, e: &RangeEpoch) -> usize {
+        self.propagate();
+        let layout = self.model.layout;
+        let (Some(b0), Some(d)) = (layout.clock, layout.clock_drift()) else {
+            return 0;
+        };
+        let lever = self.cfg.lever_arm;
+        tight.counts.epochs += 1;
+        tight.clocks.advance(e.t);
+        let antenna = ranging::Antenna::of(&self.mech.frame(), &lever, &self.w_ib_b);
+        let (preds, masked) = ranging::predictions(&tight.cfg.model, e, &antenna);
+        tight.counts.masked += masked;
+        self.start_clocks(tight, e, &preds, b0, d);
+        let (gate, reset) = tight.gate(self.cfg.gate, self.cfg.reset_after);
+        let (mut tested, mut accepted) = (0usize, 0usize);
+        for &(i, _) in &preds {
+            let s = &e.sats[i];
+            let Some(k) = tight.clock_index(s.sat.system) else {
+                continue;
+            };
+            let Some(bias) = tight.clocks.bias[k] else {
+                continue;
+            };
+            // Each measurement at the state its predecessors corrected.
+            let a = ranging::Antenna::of(&self.mech.frame(), &lever, &self.w_ib_b);
+            let Some(p) = tight.cfg.model.predict(s, e.time, &a.r_e, &a.v_e) else {
+                continue;
+            };
+            let pr = s.measurement.pseudorange.unwrap_or(f64::NAN);
+            let z = p.pseudorange + bias - pr;
+            let m = ranging::pseudorange(&layout, &a, &p.u, z, p.pseudorange_var, b0 + k);
+            tested += 1;
+            accepted += usize::from(self.apply_range(e.t, m, s.sat, gate, reset, tight));
+            let (Some(rate), Some(drift), true) = (
+                s.measurement.pseudorange_rate(),
+                tight.clocks.drift,
+                tight.cfg.use_doppler,
+            ) else {
+                continue;
+            };
+            let a = ranging::Antenna::of(&self.mech.frame(), &lever, &self.w_ib_b);
+            let Some(p) = tight.cfg.model.predict(s, e.time, &a.r_e, &a.v_e) else {
+                continue;
+            };
+            let Some(predicted) = p.rate else { continue };
+            let z = predicted + drift - rate;
+            let m = ranging::range_rate(&layout, &a, &lever, &p.u, p.k, z, p.rate_var, d);
+            tested += 1;
+            accepted += usize::from(self.apply_range(e.t, m, s.sat, gate, reset, tight));
+        }
+        if tested > 0 && accepted == 0 {
+            tight.refused_in_a_row += 1;
+            tight.counts.all_refused += 1;
+        } else if accepted > 0 {
+            tight.refused_in_a_row = 0;
+        }
+        accepted
+    }
+
+    /// Start each system's clock bias (and the drift) the epoch finds unstarted, or
+    /// restart a bias after a clock jump, from the median residual ([`super::ranging`]).
+    fn start_clocks(
+        &mut self,
+        tight: &mut Tight,
+        e: &RangeEpoch,
+        preds: &[(usize, crate::gnss::Predicted)],
+        b0: usize,
+        d: usize,
+    ) {
+        let mut restarted = Vec::new();
+        for k in 0..tight.cfg.systems.len() {
+            let system = tight.cfg.systems[k];
+            let mut res: Vec<f64> = preds
+                .iter()
+                .filter(|(i, _)| e.sats[*i].sat.system == system)
+                .filter_map(|(i, p)| Some(e.sats[*i].measurement.pseudorange? - p.pseudorange))
+                .collect();
+            let Some(m) = ranging::median(&mut res) else {
+                continue;
+            };
+            let start = match tight.clocks.bias[k] {
+                None => true,
+                Some(b) if (m - b).abs() > ranging::CLOCK_JUMP_M => {
+                    tight.clocks.jumps.push(e.t);
+                    true
+                }
+                Some(_) => false,
+            };
+            if start {
+                tight.clocks.bias[k] = Some(m);
+                restarted.push((b0 + k, tight.cfg.init_bias_std));
+            }
+        }
+        if tight.clocks.drift.is_none() && tight.cfg.use_doppler {
+            let mut res: Vec<f64> = preds
+                .iter()
+                .filter_map(|(i, p)| Some(e.sats[*i].measurement.pseudorange_rate()? - p.rate?))
+                .collect();
+            if let Some(m) = ranging::median(&mut res) {
+                tight.clocks.drift = Some(m);
+                restarted.push((d, tight.cfg.init_drift_std));
+            }
+        }
+        if restarted.is_empty() {
+            return;
+        }
+        // A restarted state: its own prior, uncorrelated with the rest.
+        for (i, std) in restarted {
+            self.kf.p.row_mut(i).fill(0.0);
+            self.kf.p.column_mut(i).fill(0.0);
+            self.kf.p[(i, i)] = std * std;
+        }
+        if let Some(log) = self.smoother.as_mut() {
+            log.feedback(&DVector::zeros(self.model.layout.n), &self.kf.p);
+        }
+    }
+
+    /// Gate one range measurement of `sat` through `gate` (`reset`: the epoch passes
+    /// the reset's bound) and, if accepted, update and feed back.
+    fn apply_range(
+        &mut self,
+        t: f64,
+        m: Measurement,
+        sat: crate::gnss::Sat,
+        gate: Gate,
+        reset: bool,
+        tight: &mut Tight,
+    ) -> bool {
+        let outcome = self.kf.update(&m.z, &m.h, &m.r, gate);
+        let Some(u) = self.book.record(t, m.kind, Some(sat), m.z, reset, outcome) else {
+            return false;
+        };
+        // `tight` is out of `self` while its epoch runs: its clock is fed back here.
+        self.feed_back(&u.dx);
+        tight.clocks.feed_back(&self.model.layout, &u.dx);
+        if let Some(log) = self.smoother.as_mut() {
+            log.feedback(&u.dx, &self.kf.p);
+        }
+        true
     }
 
     /// Apply a barometric height `h_baro` [m] with standard deviation `std` now (the
@@ -710,18 +944,18 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
     }
 }
 
-/// A filter that [`step_with_fixes`] drives: it steps samples, applies GNSS fixes and
-/// records the ones it cannot use (the psi-angle [`Integrator`] and the 18-state
-/// [`super::seed18::Seed18`]).
-pub trait FixConsumer {
+/// A filter that [`step_with_fixes`] drives with measurements `T`: it steps samples,
+/// applies GNSS fixes (or range epochs) and records the ones it cannot use (the
+/// psi-angle [`Integrator`] and the 18-state [`super::seed18::Seed18`]).
+pub trait FixConsumer<T = GnssFix> {
     /// The mechanization's time [s].
     fn now(&self) -> f64;
     /// Mechanize one sample with no fix inside it.
     fn step_sample(&mut self, s: &ImuSample);
     /// Apply a fix now.
-    fn apply_fix(&mut self, f: &GnssFix);
+    fn apply_fix(&mut self, f: &T);
     /// Record a fix that could not be used.
-    fn skip_fix(&mut self, t: f64, reason: SkipReason);
+    fn skip_fix(&mut self, f: &T, reason: SkipReason);
 }
 
 impl<M: ErrorFrame, E: EarthModel> FixConsumer for Integrator<M, E> {
@@ -734,22 +968,50 @@ impl<M: ErrorFrame, E: EarthModel> FixConsumer for Integrator<M, E> {
     fn apply_fix(&mut self, f: &GnssFix) {
         self.update_gnss(f);
     }
-    fn skip_fix(&mut self, t: f64, reason: SkipReason) {
-        self.skip(t, reason);
+    fn skip_fix(&mut self, f: &GnssFix, reason: SkipReason) {
+        self.skip(f.t, reason);
+    }
+}
+
+impl<M: ErrorFrame, E: EarthModel> FixConsumer<GnssUpdate> for Integrator<M, E> {
+    fn now(&self) -> f64 {
+        self.mech.state().t
+    }
+    fn step_sample(&mut self, s: &ImuSample) {
+        self.step(s);
+    }
+    fn apply_fix(&mut self, u: &GnssUpdate) {
+        match u {
+            GnssUpdate::Fix(f) => self.update_gnss(f),
+            GnssUpdate::Ranges(e) => {
+                self.update_ranges(e);
+            }
+        }
+    }
+    fn skip_fix(&mut self, u: &GnssUpdate, reason: SkipReason) {
+        match u {
+            GnssUpdate::Fix(f) => self.skip(f.t, reason),
+            GnssUpdate::Ranges(e) => self.skip_measurement(e.t, Kind::Pseudorange, reason),
+        }
     }
 }
 
 /// Mechanize a sample of `c` during which GNSS fixes may fall: fixes from `fixes`
 /// with times up to the sample's end are applied at their own times (the sample is
 /// split there, [`split`]); fixes before the mechanization's time are skipped.
-pub fn step_with_fixes<C: FixConsumer, F: FixSource>(c: &mut C, raw: &ImuSample, fixes: &mut F) {
+pub fn step_with_fixes<T, C: FixConsumer<T>, F: FixSource<T>>(
+    c: &mut C,
+    raw: &ImuSample,
+    fixes: &mut F,
+) {
     let tol = 1e-3 * raw.dt.max(1e-9);
     let mut rest = Some(*raw);
     while let Some(ft) = fixes.next_time() {
         let now = c.now();
         if ft < now - tol {
-            fixes.pop_fix();
-            c.skip_fix(ft, SkipReason::BeforeImu);
+            if let Some(f) = fixes.pop_fix() {
+                c.skip_fix(&f, SkipReason::BeforeImu);
+            }
             continue;
         }
         if ft <= now + tol {
@@ -778,30 +1040,31 @@ pub fn step_with_fixes<C: FixConsumer, F: FixSource>(c: &mut C, raw: &ImuSample,
     }
 }
 
-/// GNSS fixes in time order, taken one at a time by [`Integrator::step_with_fixes`]:
-/// a peekable iterator (a batch) or a queue that a streaming caller keeps filling.
-pub trait FixSource {
+/// GNSS fixes (or range epochs) in time order, taken one at a time by
+/// [`Integrator::step_with_fixes`]: a peekable iterator (a batch) or a queue that a
+/// streaming caller keeps filling.
+pub trait FixSource<T = GnssFix> {
     /// The time of the next fix, which stays in place.
     fn next_time(&mut self) -> Option<f64>;
     /// Take the next fix.
-    fn pop_fix(&mut self) -> Option<GnssFix>;
+    fn pop_fix(&mut self) -> Option<T>;
 }
 
-impl<I: Iterator<Item = GnssFix>> FixSource for std::iter::Peekable<I> {
+impl<T: Timed, I: Iterator<Item = T>> FixSource<T> for std::iter::Peekable<I> {
     fn next_time(&mut self) -> Option<f64> {
-        self.peek().map(|f| f.t)
+        self.peek().map(Timed::time)
     }
-    fn pop_fix(&mut self) -> Option<GnssFix> {
+    fn pop_fix(&mut self) -> Option<T> {
         self.next()
     }
 }
 
-impl FixSource for std::collections::VecDeque<GnssFix> {
+impl<T: Timed> FixSource<T> for std::collections::VecDeque<T> {
     #[inline]
     fn next_time(&mut self) -> Option<f64> {
-        self.front().map(|f| f.t)
+        self.front().map(Timed::time)
     }
-    fn pop_fix(&mut self) -> Option<GnssFix> {
+    fn pop_fix(&mut self) -> Option<T> {
         self.pop_front()
     }
 }

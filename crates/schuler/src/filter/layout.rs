@@ -23,6 +23,12 @@ pub struct Layout {
     /// Mounting errors of the vehicle frame (2: pitch, then yaw, about the vehicle's
     /// y and z axes), if estimated.
     pub mounting: Option<usize>,
+    /// Receiver clock biases [m], one per system in the order the filter keeps
+    /// ([`super::ranging::Clocks`]), then the common clock drift [m/s], if tight
+    /// coupling: the offset of the first bias.
+    pub clock: Option<usize>,
+    /// How many clock biases (systems) [`Layout::clock`] holds.
+    pub clock_systems: usize,
 }
 
 impl Layout {
@@ -47,6 +53,8 @@ impl Layout {
             attitude_ref: None,
             odometer_scale: None,
             mounting: None,
+            clock: None,
+            clock_systems: 0,
         }
     }
 
@@ -86,6 +94,19 @@ impl Layout {
         self
     }
 
+    /// Add receiver clock biases for `systems` systems and the clock drift.
+    pub fn with_clock(mut self, systems: usize) -> Self {
+        self.clock = Some(self.n);
+        self.clock_systems = systems;
+        self.n += systems + 1;
+        self
+    }
+
+    /// The offset of the clock drift, with a clock.
+    pub fn clock_drift(&self) -> Option<usize> {
+        self.clock.map(|o| o + self.clock_systems)
+    }
+
     /// Names of the states, for reports (`dr_x`, ..., `psi_z`, `bg_x`, ...), each at
     /// its block's offset.
     pub fn names(&self) -> Vec<String> {
@@ -121,6 +142,12 @@ impl Layout {
             names[o] = "mount_pitch".into();
             names[o + 1] = "mount_yaw".into();
         }
+        if let Some(o) = self.clock {
+            for i in 0..self.clock_systems {
+                names[o + i] = format!("clock_bias_{i}");
+            }
+            names[o + self.clock_systems] = "clock_drift".into();
+        }
         names
     }
 }
@@ -151,5 +178,11 @@ mod tests {
         // Another order of the builders: the names follow the offsets.
         let l = Layout::core().with_odometer_scale().with_baro_bias();
         assert_eq!(l.names()[15..], ["odometer_scale", "baro_bias"]);
+        let l = Layout::core().with_clock(2);
+        assert_eq!((l.n, l.clock, l.clock_drift()), (18, Some(15), Some(17)));
+        assert_eq!(
+            l.names()[15..],
+            ["clock_bias_0", "clock_bias_1", "clock_drift"]
+        );
     }
 }

@@ -39,14 +39,22 @@ pub enum Kind {
     Odometer,
     /// Dual-antenna GNSS baseline heading (and pitch).
     Heading,
+    /// One satellite's pseudorange (tight coupling).
+    Pseudorange,
+    /// One satellite's pseudorange rate from its Doppler (tight coupling).
+    RangeRate,
 }
 
 impl Kind {
     /// Unit of the innovation's components, for reports: `m`, `m/s`, `rad/s`, `rad`.
     pub fn unit(self) -> &'static str {
         match self {
-            Kind::GnssPosition | Kind::BaroHeight => "m",
-            Kind::GnssVelocity | Kind::ZeroVelocity | Kind::NonHolonomic | Kind::Odometer => "m/s",
+            Kind::GnssPosition | Kind::BaroHeight | Kind::Pseudorange => "m",
+            Kind::GnssVelocity
+            | Kind::ZeroVelocity
+            | Kind::NonHolonomic
+            | Kind::Odometer
+            | Kind::RangeRate => "m/s",
             Kind::ZeroRate => "rad/s",
             Kind::Heading => "rad",
         }
@@ -64,6 +72,8 @@ impl std::fmt::Display for Kind {
             Kind::NonHolonomic => "nhc",
             Kind::Odometer => "odometer",
             Kind::Heading => "heading",
+            Kind::Pseudorange => "pseudorange",
+            Kind::RangeRate => "range_rate",
         })
     }
 }

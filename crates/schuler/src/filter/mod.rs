@@ -9,7 +9,8 @@
 //! - [`measurement`]: GNSS position and velocity with lever arm, barometric height;
 //! - [`vehicle`]: zero velocity and angular rate at rest, the non-holonomic
 //!   constraint, odometer speed, dual-antenna heading;
-//! - [`integration`]: the loosely coupled INS/GNSS filter loop;
+//! - [`integration`]: the INS/GNSS filter loop;
+//! - [`ranging`]: tight coupling, pseudoranges and rates with the receiver clock;
 //! - [`smoother`]: the Rauch–Tung–Striebel backward pass, over [`spill`]'s records
 //!   (memory up to a budget, then a temporary file);
 //! - [`seed18`]: the flight-test paper's 18-state model on the wander mechanization;
@@ -24,14 +25,16 @@ pub mod kalman;
 pub mod layout;
 pub mod measurement;
 pub mod noise;
+pub mod ranging;
 pub mod seed18;
 pub mod smoother;
 pub mod spill;
 pub mod vehicle;
 
-pub use error_model::{ErrorModel, IntervalMeans};
+pub use error_model::{ClockNoise, ErrorModel, IntervalMeans};
 pub use integration::{FixSource, GnssFix, IntegrationConfig, Integrator, SensorEstimates};
 pub use kalman::{Gate, Kalman, Rejection, Update};
 pub use layout::Layout;
 pub use noise::ImuNoise;
+pub use ranging::{Clocks, TightConfig};
 pub use vehicle::{Baseline, HeadingReading, VehicleMount};

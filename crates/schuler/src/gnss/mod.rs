@@ -19,6 +19,7 @@ pub mod atmosphere;
 mod dop;
 mod ephemeris;
 mod orbit;
+pub mod ranging;
 pub mod raw;
 mod sat;
 pub mod spp;
@@ -32,6 +33,7 @@ pub use ephemeris::{
     NavMessage, SystemConstants,
 };
 pub use orbit::{OrbitPoint, SatState, eccentric_anomaly};
+pub use ranging::{Predicted, RangeEpoch, RangeModel, SatRange};
 pub use raw::{PhaseLock, RawEpoch, RawMeasurement, Signal};
 pub use sat::{Sat, System};
 pub use spp::{SppConfig, SppError, SppSolution};

@@ -405,16 +405,16 @@ impl SppSolution {
 }
 
 /// A satellite that passed the checks of the epoch: its measurement and ephemeris.
-struct Candidate<'a> {
-    sat: Sat,
-    signal: Signal,
-    m: &'a RawMeasurement,
-    eph: &'a Ephemeris,
-    pseudorange: f64,
+pub(crate) struct Candidate<'a> {
+    pub(crate) sat: Sat,
+    pub(crate) signal: Signal,
+    pub(crate) m: &'a RawMeasurement,
+    pub(crate) eph: &'a Ephemeris,
+    pub(crate) pseudorange: f64,
     /// Group delay of the signal [s].
-    tgd: f64,
+    pub(crate) tgd: f64,
     /// Carrier frequency [Hz].
-    freq: f64,
+    pub(crate) freq: f64,
     /// Index of its system's clock.
     clock: usize,
     /// Still in the solution (not excluded by the FDE).
@@ -532,7 +532,7 @@ pub fn solve(
 
 /// The epoch's satellites sorted into candidates and exclusions; the systems of the
 /// candidates (their clocks' order).
-fn candidates<'a>(
+pub(crate) fn candidates<'a>(
     epoch: &'a RawEpoch,
     store: &'a EphemerisStore,
     config: &SppConfig,
@@ -858,27 +858,50 @@ impl Linearisation<'_> {
 
     /// The pseudorange's variance [m²] (see the module's doc).
     fn variance(&self, c: &Candidate<'_>, el: f64, iono_m: f64) -> f64 {
-        let cfg = self.config;
-        let reported =
-            c.m.pseudorange_std
-                .filter(|s| cfg.use_reported_std && s.is_finite() && *s > 0.0);
-        let meas = reported.unwrap_or_else(|| cfg.weighting.sigma(el, c.m.cn0));
-        let mut var = meas * meas;
-        if cfg.model_errors {
-            let ura = c.eph.accuracy_m;
-            if ura.is_finite() && ura > 0.0 {
-                var += ura * ura;
-            }
-            var += if self.iono.is_some() {
-                (0.5 * iono_m).powi(2)
-            } else {
-                5.0 * 5.0
-            };
-            let tropo_err = if cfg.troposphere { 0.3 } else { 3.0 };
-            var += (tropo_err / (el.sin() + 0.1)).powi(2);
-        }
-        var
+        let iono = self.iono.map(|_| iono_m);
+        pseudorange_variance(self.config, c.m, c.eph.accuracy_m, el, iono)
     }
+}
+
+/// The variance [m²] of pseudorange `m` at elevation `el` [rad] from a satellite
+/// whose broadcast accuracy is `ura` [m]: the measurement's own σ or the weighting's,
+/// plus the model terms of the module's doc; `iono_m` the Klobuchar delay applied,
+/// `None` without one.
+pub(crate) fn pseudorange_variance(
+    cfg: &SppConfig,
+    m: &RawMeasurement,
+    ura: f64,
+    el: f64,
+    iono_m: Option<f64>,
+) -> f64 {
+    let reported = m
+        .pseudorange_std
+        .filter(|s| cfg.use_reported_std && s.is_finite() && *s > 0.0);
+    let meas = reported.unwrap_or_else(|| cfg.weighting.sigma(el, m.cn0));
+    let mut var = meas * meas;
+    if cfg.model_errors {
+        if ura.is_finite() && ura > 0.0 {
+            var += ura * ura;
+        }
+        var += match iono_m {
+            Some(i) => (0.5 * i).powi(2),
+            None => 5.0 * 5.0,
+        };
+        let tropo_err = if cfg.troposphere { 0.3 } else { 3.0 };
+        var += (tropo_err / (el.sin() + 0.1)).powi(2);
+    }
+    var
+}
+
+/// The σ [m/s] of the pseudorange rate of `m` at elevation `el` [rad]: its own when
+/// the source gives one, else [`SppConfig::doppler_sigma`] scaled as the code's σ.
+pub(crate) fn rate_sigma(cfg: &SppConfig, m: &RawMeasurement, el: f64) -> f64 {
+    let reported = m
+        .pseudorange_rate_std()
+        .filter(|s| cfg.use_reported_std && s.is_finite() && *s > 0.0);
+    reported.unwrap_or_else(|| {
+        cfg.doppler_sigma * cfg.weighting.sigma(el, m.cn0) / cfg.weighting.reference_sigma()
+    })
 }
 
 /// The masked candidates as exclusions.
@@ -986,7 +1009,6 @@ fn velocity(cands: &[Candidate<'_>], rows: &[Row], config: &SppConfig) -> Option
     let mut normal = Matrix4::<f64>::zeros();
     let mut b = Vector4::<f64>::zeros();
     let mut lin = Vec::with_capacity(rows.len());
-    let reference = config.weighting.reference_sigma();
     for row in rows {
         let c = &cands[row.cand];
         let Some(rate) = c.m.pseudorange_rate().filter(|r| r.is_finite()) else {
@@ -999,12 +1021,7 @@ fn velocity(cands: &[Candidate<'_>], rows: &[Row], config: &SppConfig) -> Option
         let k = 1.0 + row.u.dot(&v_inertial) / C;
         let h = Vector4::new(-row.u.x / k, -row.u.y / k, -row.u.z / k, 1.0);
         let y = rate - row.u.dot(&s.v_e) / k + C * s.clock_drift;
-        let reported =
-            c.m.pseudorange_rate_std()
-                .filter(|s| config.use_reported_std && s.is_finite() && *s > 0.0);
-        let sigma = reported.unwrap_or_else(|| {
-            config.doppler_sigma * config.weighting.sigma(row.look.elevation, c.m.cn0) / reference
-        });
+        let sigma = rate_sigma(config, c.m, row.look.elevation);
         let var = sigma * sigma;
         normal += (h / var) * h.transpose();
         b += h * (y / var);

@@ -47,14 +47,15 @@ impl Ephemeris {
         pseudorange: f64,
         r_rx: &Vector3<f64>,
     ) -> SatState {
-        let omega_e = self.constants().omega_e;
-        let s = self.state_at(self.transmit_time(t_rx, pseudorange));
-        // τ from the unrotated position, then once more from the rotated one (the
-        // rotation changes the range by up to 40 m, τ by 1.3e-7 s; the second pass
-        // leaves 1e-12 s).
-        let mut tau = (s.r_e - r_rx).norm() / C;
-        tau = (earth_rotation(omega_e, tau) * s.r_e - r_rx).norm() / C;
-        rotated(s, earth_rotation(omega_e, tau))
+        self.state_at_transmission(t_rx, pseudorange)
+            .seen_from(self.constants().omega_e, r_rx)
+    }
+
+    /// The satellite's state at the transmission of a pseudorange received at `t_rx`,
+    /// in the ECEF frame *of the transmission* (no receiver position needed; turn it
+    /// into the receiver's frame with [`SatState::seen_from`]).
+    pub fn state_at_transmission(&self, t_rx: GpsTime, pseudorange: f64) -> SatState {
+        self.state_at(self.transmit_time(t_rx, pseudorange))
     }
 
     /// The satellite's state whose signal reaches `r_rx` (ECEF [m]) at GPS instant
@@ -80,6 +81,19 @@ impl Ephemeris {
             }
         }
         state
+    }
+}
+
+impl SatState {
+    /// This state (in the ECEF frame of its transmission) in the ECEF frame at the
+    /// reception by a receiver at `r_rx`: turned by `R_z(Ω̇e·τ)`, `omega_e` the
+    /// system's Earth rate. τ from the unrotated position, then once more from the
+    /// rotated one (the rotation changes the range by up to 40 m, τ by 1.3e-7 s; the
+    /// second pass leaves 1e-12 s).
+    pub fn seen_from(&self, omega_e: f64, r_rx: &Vector3<f64>) -> SatState {
+        let mut tau = (self.r_e - r_rx).norm() / C;
+        tau = (earth_rotation(omega_e, tau) * self.r_e - r_rx).norm() / C;
+        rotated(*self, earth_rotation(omega_e, tau))
     }
 }
 

@@ -9,15 +9,20 @@
 //! dropped; [`super::SessionConfig::reorder_window`] sets how late an aid may be.
 
 use crate::domain::{self, Domain, DomainError};
+use crate::filter::integration::GnssUpdate;
+use crate::filter::integration::Timed;
 use crate::filter::measurement::Kind;
 use crate::filter::{GnssFix, HeadingReading};
+use crate::gnss::RangeEpoch;
 use std::collections::VecDeque;
 
 /// One aiding measurement.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Aid {
     /// A GNSS position (and optionally velocity) fix with its standard deviations.
     Gnss(GnssFix),
+    /// One epoch of pseudoranges and rates with their satellites (tight coupling).
+    Ranges(Box<RangeEpoch>),
     /// A barometric height [m] at time `t` [s].
     Baro {
         /// Time [s].
@@ -48,6 +53,7 @@ impl Aid {
     pub fn t(&self) -> f64 {
         match self {
             Aid::Gnss(f) => f.t,
+            Aid::Ranges(e) => e.t,
             Aid::Baro { t, .. } | Aid::Odometer { t, .. } => *t,
             Aid::Heading(h) => h.t,
             Aid::Rest { t0, .. } => *t0,
@@ -58,6 +64,7 @@ impl Aid {
     pub fn kind(&self) -> Kind {
         match self {
             Aid::Gnss(_) => Kind::GnssPosition,
+            Aid::Ranges(_) => Kind::Pseudorange,
             Aid::Baro { .. } => Kind::BaroHeight,
             Aid::Odometer { .. } => Kind::Odometer,
             Aid::Heading(_) => Kind::Heading,
@@ -91,6 +98,18 @@ impl Aid {
                             .or_else(|| each("vel_std", &domain::VELOCITY_STD, s.as_slice()))
                     })
                 }),
+            Aid::Ranges(e) => e.sats.iter().find_map(|s| {
+                let m = &s.measurement;
+                each(
+                    "pseudorange",
+                    &domain::PSEUDORANGE,
+                    &[m.pseudorange.unwrap_or(1e7)],
+                )
+                .or_else(|| {
+                    m.pseudorange_rate()
+                        .and_then(|r| each("pseudorange_rate", &domain::RANGE_RATE, &[r]))
+                })
+            }),
             Aid::Baro { h, .. } => each("h", &domain::HEIGHT, &[*h]),
             Aid::Odometer { speed, .. } => each("speed", &domain::SPEED, &[*speed]),
             Aid::Heading(r) => each("heading", &domain::HEADING, &[r.heading])
@@ -120,7 +139,7 @@ pub(crate) fn insert_sorted<T>(q: &mut VecDeque<T>, x: T, t: impl Fn(&T) -> f64)
 /// The aids waiting for their samples, one queue per kind, each in time order.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct AidQueues {
-    pub gnss: VecDeque<GnssFix>,
+    pub gnss: VecDeque<GnssUpdate>,
     pub baro: VecDeque<(f64, f64)>,
     pub odometer: VecDeque<(f64, f64)>,
     pub heading: VecDeque<HeadingReading>,
@@ -131,7 +150,8 @@ impl AidQueues {
     /// Queue `aid` (checked and accepted by the caller).
     pub fn push(&mut self, aid: Aid) {
         match aid {
-            Aid::Gnss(f) => insert_sorted(&mut self.gnss, f, |f| f.t),
+            Aid::Gnss(f) => insert_sorted(&mut self.gnss, GnssUpdate::Fix(f), |f| f.time()),
+            Aid::Ranges(e) => insert_sorted(&mut self.gnss, GnssUpdate::Ranges(e), |f| f.time()),
             Aid::Baro { t, h } => insert_sorted(&mut self.baro, (t, h), |r| r.0),
             Aid::Odometer { t, speed } => insert_sorted(&mut self.odometer, (t, speed), |r| r.0),
             Aid::Heading(r) => insert_sorted(&mut self.heading, r, |r| r.t),
@@ -145,6 +165,7 @@ impl AidQueues {
 pub(crate) fn is_late(aid: &Aid, t_done: f64, dt: f64) -> bool {
     match aid {
         Aid::Gnss(f) => f.t < t_done - 1e-3 * dt,
+        Aid::Ranges(e) => e.t < t_done - 1e-3 * dt,
         Aid::Baro { t, .. } | Aid::Odometer { t, .. } => *t <= t_done + 0.5 * dt,
         Aid::Heading(r) => r.t <= t_done + 0.5 * dt,
         Aid::Rest { t0, .. } => *t0 < t_done,

@@ -119,7 +119,7 @@ impl<E: EarthModel> HeadingBank<E> {
     pub fn push(&mut self, aid: Aid) -> Result<(), SessionError> {
         self.members
             .iter_mut()
-            .try_for_each(|m| m.session.push(aid))
+            .try_for_each(|m| m.session.push(aid.clone()))
     }
 
     /// Every member's initial heading [rad] and log-likelihood so far.

@@ -46,7 +46,7 @@ use crate::analysis::errors::NavRecord;
 use crate::channel::vertical::DetectorCounts;
 use crate::earth::EarthModel;
 use crate::filter::gate_book::GateBook;
-use crate::filter::integration::{Counts, SkipReason, Skipped};
+use crate::filter::integration::{Counts, FixConsumer, GnssUpdate, SkipReason, Skipped, Timed};
 use crate::filter::measurement::Kind;
 use crate::filter::seed18::Seed18;
 use crate::filter::smoother::SmoothedTrajectory;
@@ -216,6 +216,8 @@ struct Loop {
     /// The last output time with a finite state, and the failure once it is not.
     last_good: f64,
     failure: Option<SessionError>,
+    /// Tight coupling's settings ([`Session::with_tight`]).
+    tight: Option<crate::filter::TightConfig>,
 }
 
 impl Aid {
@@ -293,9 +295,37 @@ impl<E: EarthModel> Session<E> {
                 left_envelope: [false; 3],
                 last_good: f64::NAN,
                 failure: None,
+                tight: None,
                 cfg: config,
             },
         })
+    }
+
+    /// Tight coupling: [`Aid::Ranges`] become pseudorange and rate updates of the
+    /// filter, whose state gains the receiver clock ([`crate::filter::ranging`]).
+    /// Needs the psi-angle filter; call before the first sample.
+    pub fn with_tight(mut self, cfg: crate::filter::TightConfig) -> Result<Self, SessionError> {
+        let refuse = |why: &str| {
+            Err(SessionError::Config(ConfigError::new(
+                "tight",
+                why.to_string(),
+            )))
+        };
+        match &self.run.cfg.filter {
+            None => return refuse("tight coupling needs the filter"),
+            Some(f) if f.error_model == ErrorModelChoice::Seed18 => {
+                return refuse("tight coupling needs the psi-angle error model, not seed18");
+            }
+            Some(_) => {}
+        }
+        if cfg.systems.is_empty() {
+            return refuse("tight coupling needs at least one system");
+        }
+        if self.core.is_some() {
+            return refuse("tight coupling must be set before the first sample");
+        }
+        self.run.tight = Some(cfg);
+        Ok(self)
     }
 
     /// The filter's snapshots carry NEES against `truth` (sorted by time).
@@ -459,7 +489,10 @@ impl<E: EarthModel> Session<E> {
                 let mut left: Vec<(f64, Kind)> = q
                     .gnss
                     .drain(..)
-                    .map(|f| (f.t, Kind::GnssPosition))
+                    .map(|u| match u {
+                        GnssUpdate::Fix(f) => (f.t, Kind::GnssPosition),
+                        GnssUpdate::Ranges(e) => (e.t, Kind::Pseudorange),
+                    })
                     .collect();
                 left.extend(q.baro.drain(..).map(|r| (r.0, Kind::BaroHeight)));
                 left.extend(q.odometer.drain(..).map(|r| (r.0, Kind::Odometer)));
@@ -649,6 +682,9 @@ impl Loop {
         let f = self.cfg.filter.as_ref();
         match aid {
             Aid::Gnss(_) if f.is_none() => Some("GNSS needs the filter"),
+            Aid::Ranges(_) if self.tight.is_none() => {
+                Some("raw GNSS ranges need tight coupling in the configuration")
+            }
             Aid::Baro { .. }
                 if f.is_none_or(|f| f.integration.baro.is_none()) && self.baro_loop.is_none() =>
             {
@@ -741,6 +777,10 @@ impl Loop {
         }
         let integ = match &self.vehicle {
             Some(v) => v.configure(integ),
+            None => integ,
+        };
+        let integ = match &self.tight {
+            Some(t) => integ.with_tight(t.clone()),
             None => integ,
         };
         if f.smooth {
@@ -926,16 +966,16 @@ impl Loop {
     /// At the end of the input under the 18-state filter: fixes after the last
     /// sample are skipped.
     fn finish_seed18<E: EarthModel>(&mut self, f: &mut Seed18<E>) {
-        while let Some(fix) = self.queues.gnss.pop_front() {
-            f.skip(fix.t, SkipReason::AfterImu);
+        while let Some(u) = self.queues.gnss.pop_front() {
+            f.skip(u.time(), SkipReason::AfterImu);
         }
         self.take_seed18(f);
     }
 
     /// At the end of the input: aids after the last sample are skipped.
     fn finish_filter<M: ErrorFrame, E: EarthModel>(&mut self, integ: &mut Integrator<M, E>) {
-        while let Some(f) = self.queues.gnss.pop_front() {
-            integ.skip(f.t, SkipReason::AfterImu);
+        while let Some(u) = self.queues.gnss.pop_front() {
+            FixConsumer::<GnssUpdate>::skip_fix(integ, &u, SkipReason::AfterImu);
         }
         while let Some((t, _)) = self.queues.baro.pop_front() {
             integ.skip_measurement(t, Kind::BaroHeight, SkipReason::AfterImu);

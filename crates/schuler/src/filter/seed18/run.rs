@@ -7,8 +7,8 @@ use super::model::{self, ACCEL, GYRO, HEIGHT, Mat18, N, NAV_Q, ORI_Q, Point, VEL
 use crate::earth::EarthModel;
 use crate::filter::gate_book::GateBook;
 use crate::filter::integration::{
-    FixConsumer, FixSource, GnssFix, IntegrationConfig, SensorEstimates, SkipReason,
-    step_with_fixes,
+    FixConsumer, FixSource, GnssFix, GnssUpdate, IntegrationConfig, SensorEstimates, SkipReason,
+    Timed, step_with_fixes,
 };
 use crate::filter::interval::Interval;
 use crate::filter::kalman::Kalman;
@@ -176,7 +176,10 @@ impl<E: EarthModel> Seed18<E> {
     }
 
     /// Mechanize a sample during which GNSS fixes may fall (applied at their times).
-    pub fn step_with_fixes<F: FixSource>(&mut self, raw: &ImuSample, fixes: &mut F) {
+    pub fn step_with_fixes<T, F: FixSource<T>>(&mut self, raw: &ImuSample, fixes: &mut F)
+    where
+        Self: FixConsumer<T>,
+    {
         step_with_fixes(self, raw, fixes);
     }
 
@@ -203,7 +206,7 @@ impl<E: EarthModel> Seed18<E> {
         let h = DMatrix::from_column_slice(3, N, m.h.as_slice());
         let r = DMatrix::from_column_slice(3, 3, m.r.as_slice());
         let outcome = self.kf.update(&z, &h, &r, gate);
-        let Some(u) = self.book.record(t, kind, z, reset, outcome) else {
+        let Some(u) = self.book.record(t, kind, None, z, reset, outcome) else {
             return false;
         };
         self.feed_back(&u.dx);
@@ -309,7 +312,28 @@ impl<E: EarthModel> FixConsumer for Seed18<E> {
     fn apply_fix(&mut self, f: &GnssFix) {
         self.update_gnss(f);
     }
-    fn skip_fix(&mut self, t: f64, reason: SkipReason) {
-        self.skip(t, reason);
+    fn skip_fix(&mut self, f: &GnssFix, reason: SkipReason) {
+        self.skip(f.t, reason);
+    }
+}
+
+/// The 18-state model takes fixes only: [`crate::session::SessionConfig::validate`]
+/// refuses tight coupling with it, and a range epoch that reaches it all the same is
+/// recorded as skipped, never applied.
+impl<E: EarthModel> FixConsumer<GnssUpdate> for Seed18<E> {
+    fn now(&self) -> f64 {
+        self.mech.wander_state().t
+    }
+    fn step_sample(&mut self, s: &ImuSample) {
+        self.step(s);
+    }
+    fn apply_fix(&mut self, u: &GnssUpdate) {
+        match u {
+            GnssUpdate::Fix(f) => self.update_gnss(f),
+            GnssUpdate::Ranges(e) => self.skip(e.t, SkipReason::NotModelled),
+        }
+    }
+    fn skip_fix(&mut self, u: &GnssUpdate, reason: SkipReason) {
+        self.skip(u.time(), reason);
     }
 }
