@@ -816,6 +816,11 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             if let Some(m) = ranging::median(&mut res) {
                 tight.clocks.drift = Some(m);
                 restarted.push((d, tight.cfg.init_drift_std));
+            } else if tight.clocks.bias.iter().any(Option::is_some) {
+                // No Doppler: the drift from the biases' course, from 0 with an
+                // oscillator's offset for prior.
+                tight.clocks.drift = Some(0.0);
+                restarted.push((d, ranging::DRIFT_STD_WITHOUT_DOPPLER));
             }
         }
         if restarted.is_empty() {

@@ -21,7 +21,8 @@
 //!
 //! The clock is started from the measurements: at a system's first epoch its bias is
 //! the median of `P − P̂` (the filter's own position in `P̂`), with prior σ
-//! [`TightConfig::init_bias_std`]; the drift likewise from the first Dopplers. A
+//! [`TightConfig::init_bias_std`]; the drift likewise from the first Dopplers, or
+//! from 0 with [`DRIFT_STD_WITHOUT_DOPPLER`] when there are none. A
 //! receiver clock jump (receivers that hold their clock within 1 ms of GPS time step
 //! it by a millisecond, 300 km) shows as a median more than [`CLOCK_JUMP_M`] off the
 //! prediction: the bias restarts there, and the restart is counted.
@@ -39,6 +40,10 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 /// A median pseudorange residual this far from the clock's prediction [m] is a jump of
 /// the receiver clock (0.1 ms; no filter is this far off and every satellite alike).
 pub const CLOCK_JUMP_M: f64 = 3.0e4;
+
+/// Prior σ of the clock drift [m/s] when the first epochs carry no Doppler: a TCXO's
+/// frequency offset of 1 ppm (c·1e-6), found then from the course of the biases.
+pub const DRIFT_STD_WITHOUT_DOPPLER: f64 = 300.0;
 
 /// Settings of tight coupling.
 #[derive(Debug, Clone, PartialEq)]
