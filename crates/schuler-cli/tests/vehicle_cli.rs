@@ -268,7 +268,7 @@ fn bad_vehicle_inputs_name_file_line_and_field() {
         (vec!["--nhc-std", "0.1 m/s"], "--nhc-std needs --nhc".into()),
         (
             vec!["--zupt", &good_rest, "--zupt-std", "0 m/s"],
-            "--zupt-std must be positive".into(),
+            "--zupt-std: velocity standard deviation 0 m/s is outside".into(),
         ),
         (
             vec!["--odometer", &good_odo, "--odometer-std", "2 deg"],
