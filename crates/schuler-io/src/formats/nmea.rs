@@ -579,7 +579,7 @@ mod tests {
         let w = got.warnings.join("\n");
         for want in [
             "3 bad NMEA sentences skipped (checksum, malformed field or a position out of \
-             range; the first at line 2: Checksum Mismatch",
+             range; the first at line 2: checksum 00 where the sentence's bytes give 71)",
             "1 lines that are not NMEA sentences ignored",
             "1 GGA epochs without a fix (quality 0) skipped",
             "1 GGA epochs of dead reckoning (quality 6) skipped",
