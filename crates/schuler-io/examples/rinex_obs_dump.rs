@@ -13,28 +13,13 @@
 
 use schuler_io::formats::rinex::obs::{Epoch, ObsReader};
 use std::io::Write;
-use std::path::PathBuf;
 use std::process::ExitCode;
 
+#[path = "common/dump_cli.rs"]
+mod dump_cli;
+
 fn main() -> ExitCode {
-    let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
-    let result = match args.as_slice() {
-        [path] => dump(path),
-        [flag, paths @ ..] if flag.as_os_str() == "--time" => {
-            paths.iter().try_for_each(|p| time(p))
-        }
-        _ => {
-            eprintln!("usage: rinex_obs_dump FILE | rinex_obs_dump --time FILE...");
-            return ExitCode::from(2);
-        }
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("{e}");
-            ExitCode::FAILURE
-        }
-    }
+    dump_cli::run("rinex_obs_dump", dump, time)
 }
 
 fn dump(path: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {

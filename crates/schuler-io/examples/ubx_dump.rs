@@ -18,28 +18,14 @@
 use schuler_io::logs::ubx::{UbxOptions, UbxReader};
 use schuler_io::logs::{LogReader, LogRecord};
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
+#[path = "common/dump_cli.rs"]
+mod dump_cli;
+
 fn main() -> ExitCode {
-    let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
-    let result = match args.as_slice() {
-        [path] => dump(path),
-        [flag, paths @ ..] if flag.as_os_str() == "--time" => {
-            paths.iter().try_for_each(|p| time(p))
-        }
-        _ => {
-            eprintln!("usage: ubx_dump FILE | ubx_dump --time FILE...");
-            return ExitCode::from(2);
-        }
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("{e}");
-            ExitCode::FAILURE
-        }
-    }
+    dump_cli::run("ubx_dump", dump, time)
 }
 
 fn opt(v: Option<f64>) -> String {
