@@ -14,8 +14,8 @@ use schuler::nav::LocalLevel;
 use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::receivers::{GnssModel, Interval};
 use std::sync::OnceLock;
-mod common;
-use common::{Data, scenario, simulated};
+use crate::common;
+use crate::common::{Data, scenario, simulated};
 
 const SCENARIO: &str = r#"
 seed = 1

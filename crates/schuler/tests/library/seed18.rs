@@ -31,8 +31,8 @@ use schuler::sim::scenario::{Quantity, SegmentSpec};
 use schuler::sim::sensor_spec::Axes;
 use std::sync::OnceLock;
 
-mod common;
-use common::{Data, EXAMPLE_DRIVE, EXAMPLE_SORTIE, scenario, simulated, with_holds};
+use crate::common;
+use crate::common::{Data, EXAMPLE_DRIVE, EXAMPLE_SORTIE, scenario, simulated, with_holds};
 
 /// A polar-flight leg: from 89° N at 100 m/s towards the pole with a turn, 5 minutes.
 const POLAR: &str = r#"

@@ -22,7 +22,7 @@ use schuler::nav::NavState;
 use schuler::refine::{SecondUnitRefinement, TwoUnitFilter, earth_to_inertial};
 use schuler::rotation::{dcm_from_rotation_vector, rotation_vector_from_quaternion};
 use schuler::sim::imu_model::ImuSimulator;
-mod common;
+use crate::common;
 
 /// Hovering at 89.8° N (the Earth's rate 0.2° from the vertical), turning on the spot
 /// right and left at 2°/s, hovering, then rolling to 20° and back.

@@ -22,8 +22,8 @@ use schuler::gnss::{
 use schuler::nav::LocalLevel;
 use schuler::sim::imu_model::ImuSimulator;
 use std::sync::OnceLock;
-mod common;
-use common::{Data, scenario, simulated};
+use crate::common;
+use crate::common::{Data, scenario, simulated};
 
 const SCENARIO: &str = r#"
 seed = 7
