@@ -11,7 +11,27 @@ pub fn load_scenario(path: &Path) -> Result<ScenarioSpec> {
     let text = schuler_io::formats::read_config_text(path)?;
     let spec: ScenarioSpec =
         toml::from_str(&text).with_context(|| format!("in {}", path.display()))?;
-    with_motion_csv(spec, path.parent().unwrap_or(Path::new("")))
+    let dir = path.parent().unwrap_or(Path::new(""));
+    with_raw_nav(with_motion_csv(spec, dir)?, dir)
+}
+
+/// `spec` with the navigation file of its `[gnss.raw]` block (a path relative to
+/// `dir`), if it names one, read.
+pub fn with_raw_nav(mut spec: ScenarioSpec, dir: &Path) -> Result<ScenarioSpec> {
+    let Some(raw) = spec.gnss.as_mut().and_then(|g| g.raw.as_mut()) else {
+        return Ok(spec);
+    };
+    if let Some(nav) = &raw.nav {
+        let path = dir.join(nav);
+        let (_, klobuchar, store) = schuler_io::formats::rinex::nav::read_store(&path)
+            .with_context(|| "gnss.raw.nav".to_string())?;
+        raw.data = Some(schuler::sim::raw_gnss::spec::NavData {
+            store,
+            klobuchar,
+            file: Some(path),
+        });
+    }
+    Ok(spec)
 }
 
 /// `spec` with its `motion_csv` (a path relative to `dir`), if it names one, read.

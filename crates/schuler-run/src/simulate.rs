@@ -23,6 +23,14 @@
 //! - `imu_err_truth.txt`: the true IMU errors once a second in the layout of `schuler
 //!   nav`'s `imu_err.txt` (`t`, gyro bias [deg/h], accelerometer bias [mGal], gyro and
 //!   accelerometer scale factors [ppm]), for `schuler nav --sensor-truth`;
+//! - with `[gnss.raw]`: `gnss_obs.rnx`, the raw observations (RINEX 3.04: C1C, D1C,
+//!   S1C per signal; [`schuler::sim::raw_gnss`]) at the receiver clock's epochs,
+//!   `gnss_nav.rnx`, the navigation file they were made from (the scenario's, as
+//!   plain text; or the nominal constellation's, written and read back so that the
+//!   file and the observations agree exactly), and `gnss_raw_truth.csv`
+//!   (`t_rx,t_gps,clock_bias_s,clock_drift,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,sats`: the
+//!   epoch's receiver time and true GPS time [s of week], the receiver clock, the
+//!   antenna's ECEF position and velocity, the satellites seen);
 //! - `scenario.resolved.toml`: every parameter actually used, seed included.
 //!
 //! Blocks of samples are formatted on the simulator's workers, each block while others
@@ -406,11 +414,92 @@ pub fn simulate_to_dir(spec: &ScenarioSpec, dir: &Path) -> Result<schuler::sim::
         )));
     }
     let summary = summary?;
+    if spec.gnss.as_ref().is_some_and(|g| g.raw.is_some()) {
+        write_raw_gnss(spec, dir)?;
+    }
     let resolved =
         toml::to_string(&spec.resolved()).context("cannot serialize the resolved scenario")?;
     let path = dir.join("scenario.resolved.toml");
     schuler_io::line_file::write_whole(&path, resolved)?;
     Ok(summary)
+}
+
+/// The raw GNSS files of `spec` (its `[gnss.raw]`) in `dir`: `gnss_nav.rnx`,
+/// `gnss_obs.rnx`, `gnss_raw_truth.csv`.
+fn write_raw_gnss(spec: &ScenarioSpec, dir: &Path) -> Result<()> {
+    use schuler::sim::raw_gnss::trajectory::{nominal_data, prepare, simulate_raw};
+    use schuler_io::formats::rinex::write::{ObsFileInfo, ObsWriter, copy_plain, write_gps_nav};
+    let (raw, model, antenna) = prepare(spec)?;
+    let nav_path = dir.join("gnss_nav.rnx");
+    let data = match &raw.data {
+        Some(d) => {
+            if let Some(file) = &d.file {
+                copy_plain(file, &nav_path)?;
+            }
+            d.clone()
+        }
+        None => {
+            let made = nominal_data(&model, antenna.span());
+            let ephemerides = made.store.sats().flat_map(|s| made.store.of(s));
+            let mut text = Vec::new();
+            write_gps_nav(
+                &mut text,
+                "schuler simulate",
+                made.klobuchar.as_ref(),
+                ephemerides,
+            )?;
+            schuler_io::line_file::write_whole(&nav_path, text)?;
+            // The observations from the file as read back: the same numbers exactly.
+            let (_, klobuchar, store) = schuler_io::formats::rinex::nav::read_store(&nav_path)?;
+            schuler::sim::raw_gnss::spec::NavData {
+                store,
+                klobuchar,
+                file: None,
+            }
+        }
+    };
+    let epochs = simulate_raw(spec, &data)?;
+    let first = epochs
+        .first()
+        .map_or([0.0; 3], |e| [e.r_e.x, e.r_e.y, e.r_e.z]);
+    let obs_path = dir.join("gnss_obs.rnx");
+    let file = std::fs::File::create(&obs_path)
+        .with_context(|| format!("cannot create {}", obs_path.display()))?;
+    let mut w = ObsWriter::new(
+        std::io::BufWriter::new(file),
+        ObsFileInfo {
+            marker: "SCHULER-SIM".into(),
+            approx_position: first,
+            program: "schuler simulate".into(),
+            interval: Some(model.interval),
+            signals: model.signals.clone(),
+        },
+    );
+    let mut truth =
+        b"t_rx,t_gps,clock_bias_s,clock_drift,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,sats\n".to_vec();
+    for e in &epochs {
+        w.epoch(&e.epoch)
+            .with_context(|| format!("cannot write {}", obs_path.display()))?;
+        let week_start = schuler::gnss::GpsTime::new(model.week, 0.0);
+        let row = [
+            e.epoch.t.diff_s(week_start),
+            e.t_true.diff_s(week_start),
+            e.clock_bias,
+            e.clock_drift,
+            e.r_e.x,
+            e.r_e.y,
+            e.r_e.z,
+            e.v_e.x,
+            e.v_e.y,
+            e.v_e.z,
+            e.epoch.sats().len() as f64,
+        ];
+        push_shortest_line(&mut truth, &row, b',');
+    }
+    w.finish()
+        .with_context(|| format!("cannot write {}", obs_path.display()))?;
+    schuler_io::line_file::write_whole(&dir.join("gnss_raw_truth.csv"), truth)?;
+    Ok(())
 }
 
 #[cfg(test)]

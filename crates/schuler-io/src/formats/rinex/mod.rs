@@ -9,6 +9,7 @@ mod hatanaka;
 pub mod nav;
 pub mod obs;
 pub mod raw;
+pub mod write;
 
 use crate::formats::InputError;
 use crate::formats::error::InputErrorKind;
