@@ -3,6 +3,8 @@
 //! 60-s GNSS outages. The truth is the simulator's exact trajectory; the sensors'
 //! errors are drawn per run from the tactical preset.
 
+use crate::common;
+use crate::common::{Data, scenario, simulated};
 use nalgebra::Vector3;
 use schuler::analysis::consistency::{ChiSquareTest, mean_bounds, normalized_squared};
 use schuler::analysis::errors::errors_between;
@@ -14,8 +16,6 @@ use schuler::nav::LocalLevel;
 use schuler::sim::imu_model::ImuSimulator;
 use schuler::sim::receivers::{GnssModel, Interval};
 use std::sync::OnceLock;
-use crate::common;
-use crate::common::{Data, scenario, simulated};
 
 const SCENARIO: &str = r#"
 seed = 1

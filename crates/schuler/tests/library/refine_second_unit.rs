@@ -14,6 +14,7 @@
 //! - a roll shows the heading difference;
 //! - every estimate is within 3σ of the truth.
 
+use crate::common;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use schuler::analysis::consistency::mean_bounds;
 use schuler::earth::{EarthModel, Wgs84, c_ne};
@@ -22,7 +23,6 @@ use schuler::nav::NavState;
 use schuler::refine::{SecondUnitRefinement, TwoUnitFilter, earth_to_inertial};
 use schuler::rotation::{dcm_from_rotation_vector, rotation_vector_from_quaternion};
 use schuler::sim::imu_model::ImuSimulator;
-use crate::common;
 
 /// Hovering at 89.8° N (the Earth's rate 0.2° from the vertical), turning on the spot
 /// right and left at 2°/s, hovering, then rolling to 20° and back.

@@ -8,6 +8,7 @@
 //! Sagnac effect ([`schuler::gnss::RangeModel`]). Atmosphere off in both, so the only
 //! errors are the drawn code and Doppler noise, the IMU's and the clock's.
 
+use crate::common::{Data, scenario, simulated};
 use nalgebra::Vector3;
 use schuler::analysis::errors::errors_between;
 use schuler::earth::{EarthModel, Wgs84};
@@ -22,8 +23,6 @@ use schuler::gnss::{
 use schuler::nav::LocalLevel;
 use schuler::sim::imu_model::ImuSimulator;
 use std::sync::OnceLock;
-use crate::common;
-use crate::common::{Data, scenario, simulated};
 
 const SCENARIO: &str = r#"
 seed = 7
