@@ -10,8 +10,8 @@
 //! report.
 
 use anyhow::{Result, bail};
-use schuler::filter::TightConfig;
-use schuler::gnss::{EphemerisStore, RangeEpoch, RangeModel, SppConfig};
+use schuler::filter::{GnssFix, TightConfig};
+use schuler::gnss::{EphemerisStore, RangeEpoch, RangeModel, SppConfig, spp};
 use schuler::session::Aid;
 use schuler_io::formats::rinex::{obs::ObsReader, raw::raw_epoch};
 use std::path::{Path, PathBuf};
@@ -110,6 +110,36 @@ impl RawGnss {
     pub fn take_error(&self) -> Option<anyhow::Error> {
         let mut slot = self.error.lock().ok()?;
         slot.take().map(anyhow::Error::msg)
+    }
+
+    /// The single-point solution of every epoch that has one (position and Doppler
+    /// velocity, [`spp::solve`] with the run's mask, systems and atmosphere), as
+    /// fixes at GPS time on the run's clock: what `--init gnss` starts from when the
+    /// run has raw observations and no fixes.
+    pub fn spp_fixes(&self) -> Result<Vec<GnssFix>> {
+        let mut reader = ObsReader::open(&self.obs)?;
+        let (mut fixes, mut prior, mut week0) = (Vec::new(), None, None);
+        let model = &self.tight.model;
+        while let Some(epoch) = reader.next() {
+            let epoch = epoch?;
+            let Some(raw) = raw_epoch(&epoch, &reader.header().glonass_channels) else {
+                continue;
+            };
+            let w0 = *week0.get_or_insert(raw.t.week);
+            if let Ok(sol) = spp::solve(
+                &raw,
+                &self.store,
+                model.klobuchar.as_ref(),
+                &model.config,
+                prior,
+            ) {
+                prior = Some(sol.r_e);
+                let t = sol.gps_time();
+                let t = t.sow + WEEK_S * (t.week - w0) as f64 + self.time_offset;
+                fixes.push(GnssFix::from_spp(&sol, t));
+            }
+        }
+        Ok(fixes)
     }
 
     /// Every epoch as an aid, or the first read error.

@@ -73,10 +73,10 @@ pub struct NavPlan {
 
 /// The initial position of flags over config, checked.
 fn init_pos(args: &NavArgs, cfg: &NavConfig) -> Result<Geodetic> {
-    let Triple([lat, lon, h]) = args
-        .init_pos
-        .or(cfg.init_pos)
-        .context("no initial position: give --init-pos LAT,LON,H (deg, deg, m)")?;
+    let Triple([lat, lon, h]) = args.init_pos.or(cfg.init_pos).context(
+        "no initial position: give --init-pos LAT,LON,H (deg, deg, m), or --init gnss \
+             to start in motion from the GNSS fixes (--gnss) or raw observations (--gnss-obs)",
+    )?;
     schuler_io::formats::gnss::position_in_domain(lat, lon, h)
         .map_err(|(_, e)| anyhow!("--init-pos: {e}"))
 }

@@ -101,10 +101,14 @@ where
     };
     let name = clap::ValueEnum::to_possible_value(&init)
         .map_or_else(|| format!("{init:?}"), |v| v.get_name().to_owned());
-    let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty()) else {
-        bail!("--init {name} needs GNSS fixes (--gnss FILE)");
+    let Some(aiding) = aiding.filter(|a| !a.fixes.is_empty() || a.raw.is_some()) else {
+        bail!("--init {name} needs GNSS fixes (--gnss FILE) or raw observations (--gnss-obs)");
     };
-    let all = aiding.fixes.to_vec()?;
+    // Raw observations alone: their single-point solutions.
+    let all = match &aiding.raw {
+        Some(raw) if aiding.fixes.is_empty() => raw.spp_fixes()?,
+        _ => aiding.fixes.to_vec()?,
+    };
     let (cfg, earth, fixes) = (InMotionConfig::default(), Wgs84, &all);
     // The start's failures are the fixes' (their number, order, values), not the IMU
     // file's: the messages say so.

@@ -294,6 +294,29 @@ pub(crate) fn predictions(
     (out, masked)
 }
 
+impl super::GnssFix {
+    /// A single-point solution as a fix at time `t` (the run's clock): its position,
+    /// the standard deviations of its covariance turned to north, east, down
+    /// (`P_n = C_en P_e C_enᵀ`, diagonal), and its Doppler velocity likewise when it
+    /// has one. The start of a tightly coupled run (`--init gnss`) takes these.
+    pub fn from_spp(sol: &crate::gnss::SppSolution, t: f64) -> Self {
+        let g = sol.geodetic;
+        let c_en = crate::earth::c_ne(g.lat, g.lon).transpose();
+        let std_ned = |p_e: Matrix3<f64>| (c_en * p_e * c_en.transpose()).diagonal().map(f64::sqrt);
+        let p_e: Matrix3<f64> = sol.cov.fixed_view::<3, 3>(0, 0).into_owned();
+        let vel = sol
+            .v_e
+            .zip(sol.cov_velocity)
+            .map(|(v_e, p)| (c_en * v_e, std_ned(p.fixed_view::<3, 3>(0, 0).into_owned())));
+        Self {
+            t,
+            pos: g,
+            pos_std: std_ned(p_e),
+            vel,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
