@@ -19,6 +19,7 @@
 //!   tightly coupled filter takes a receiver's or a phone's measurements as it takes a
 //!   RINEX file's.
 
+pub mod clock;
 pub mod gnss_logger;
 pub mod ubx;
 pub mod ulog;

@@ -27,7 +27,8 @@
 //! several (the others' increments are lost), and strapdown integration of it would be
 //! wrong; the error ([`InputErrorKind::LayoutMismatch`]) says so.
 
-pub mod clock;
+/// The device-to-GPS clock, shared with the DataFlash reader ([`crate::logs::clock`]).
+pub use crate::logs::clock;
 pub mod container;
 pub mod format;
 pub mod topics;

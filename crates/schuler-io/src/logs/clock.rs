@@ -1,10 +1,14 @@
-//! The clock of a ULog's records. Every ULog timestamp is the autopilot's clock,
-//! microseconds since boot (`hrt_absolute_time`). A GNSS message carrying the fix's
-//! UTC (`time_utc_usec`, microseconds since 1970, leap seconds not counted) ties that
-//! clock to GPS time: `gps_µs = utc_µs − 315 964 800·10⁶ + (GPS − UTC)·10⁶`, GPS − UTC
-//! by [`crate::bag::clock::leap_seconds_at`] at the fix's date; every device time maps
-//! by the offset `gps_µs − device_µs` of the first valid fix (one offset for the log:
-//! the autopilot's clock drifts by its crystal's 10⁻⁵ at most, 10 ms per 1000 s).
+//! The clock of an autopilot's log records (PX4 ULog, ArduPilot DataFlash): every
+//! timestamp is the autopilot's clock, microseconds since boot. One GNSS fix ties that
+//! clock to GPS time, and every device time maps by the offset `gps_µs − device_µs` of
+//! that fix (one offset for the log: the autopilot's clock drifts by its crystal's
+//! 10⁻⁵ at most, 10 ms per 1000 s). The fix gives GPS time either
+//! - as UTC (ULog's `time_utc_usec`, microseconds since 1970, leap seconds not
+//!   counted): `gps_µs = utc_µs − 315 964 800·10⁶ + (GPS − UTC)·10⁶`, GPS − UTC by
+//!   [`crate::bag::clock::leap_seconds_at`] at the fix's date ([`GpsTie`],
+//!   [`Clock::new`]); or
+//! - as GPS week and milliseconds of week (DataFlash `GPS.GWk`, `GPS.GMS`):
+//!   `gps_µs = week·604 800·10⁶ + ms·10³` ([`Clock::from_gps_us`]).
 //!
 //! All sums are in integer microseconds and turned into seconds once, by one correctly
 //! rounded division by 10⁶, so the same file gives the same times bit for bit (and a
@@ -62,7 +66,17 @@ impl Clock {
         };
         let gps_us = i128::from(tie.utc_us) - i128::from(GPS_EPOCH_UNIX) * 1_000_000
             + i128::from(tie.leap_s) * 1_000_000;
-        let offset = gps_us - i128::from(tie.device_us);
+        Self::tied(start_us, tie.device_us, gps_us)
+    }
+
+    /// The clock of a log starting at device time `start_us` whose fix at `device_us`
+    /// was at `gps_us` microseconds since the GPS epoch (1980-01-06 00:00:00 GPS).
+    pub fn from_gps_us(start_us: u64, device_us: u64, gps_us: u64) -> Self {
+        Self::tied(start_us, device_us, i128::from(gps_us))
+    }
+
+    fn tied(start_us: u64, device_us: u64, gps_us: i128) -> Self {
+        let offset = gps_us - i128::from(device_us);
         // The week of the log's start, or of the fix if the start maps before 1980.
         let start = i128::from(start_us) + offset;
         let start = if start >= 0 { start } else { gps_us };
@@ -112,5 +126,13 @@ mod tests {
         assert_eq!(c.seconds(51_500_000), sow + 1.5);
         assert_eq!(GpsTie::new(1, 0), None);
         assert_eq!(Clock::new(0, None).seconds(2_500_000), 2.5);
+        // The same instant given as GPS week 2288 and milliseconds of week.
+        let ms = (2 * 86_400 + 80_000 + 18) * 1000;
+        let g = Clock::from_gps_us(
+            10_000_000,
+            50_000_000,
+            2288 * WEEK as u64 * 1_000_000 + ms * 1000,
+        );
+        assert_eq!(g, c);
     }
 }
