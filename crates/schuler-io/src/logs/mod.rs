@@ -20,6 +20,7 @@
 //!   RINEX file's.
 
 pub mod clock;
+pub mod dataflash;
 pub mod gnss_logger;
 pub mod ubx;
 pub mod ulog;
