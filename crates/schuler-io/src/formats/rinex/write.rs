@@ -505,9 +505,12 @@ mod tests {
             ] {
                 assert!(close(x, y), "{} {x} {y}", r.sat);
             }
-            // The orbit the file gives: within 10 µm of the one written.
+            // The orbit the file gives, against the one written: the file's 13
+            // significant digits leave 5e-13 relative on each element, 1e-12 on
+            // A = (√A)² (27 µm at 26 600 km) and 13 µm from each angle: 100 µm.
             let t = r.toe.add_s(1800.0);
-            assert!((r.state_at(t).r_e - w.state_at(t).r_e).norm() < 1e-5);
+            let d = (r.state_at(t).r_e - w.state_at(t).r_e).norm();
+            assert!(d < 1e-4, "{}: {d} m", r.sat);
         }
     }
 }
