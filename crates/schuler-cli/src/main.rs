@@ -43,6 +43,9 @@ enum Command {
     /// Monte-Carlo campaign: N seeds of a scenario simulated, navigated and compared
     /// on every core; a table of one row per run and a report.
     Montecarlo(schuler_cli::commands::montecarlo::Args),
+    /// Error budget: the filter's covariance along a scenario's truth and each error
+    /// source's share of it (sigma.csv, shares.csv).
+    Budget(schuler_cli::commands::budget::Args),
 }
 
 /// `cmd` and its subcommands with every option that takes a value accepting one that
@@ -79,6 +82,7 @@ fn main() -> ExitCode {
         Command::Bag(args) => schuler_cli::commands::bag::run(args),
         Command::Gnss(args) => schuler_cli::commands::gnss::run(args),
         Command::Montecarlo(args) => schuler_cli::commands::montecarlo::run(args),
+        Command::Budget(args) => schuler_cli::commands::budget::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

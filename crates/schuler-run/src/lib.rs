@@ -13,6 +13,7 @@ pub mod aided;
 pub mod alignment;
 pub mod allan;
 pub mod bag_input;
+pub mod budget;
 pub mod campaign;
 pub mod channel;
 pub mod compare;

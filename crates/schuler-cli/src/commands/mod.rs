@@ -4,6 +4,7 @@
 pub mod align;
 pub mod allan;
 pub mod bag;
+pub mod budget;
 pub mod channel;
 pub mod compare;
 pub mod demo;

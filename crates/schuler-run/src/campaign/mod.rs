@@ -36,7 +36,7 @@ pub struct RunResult {
 }
 
 /// The GNSS outages of the scenario, for the statistics' outage maxima [s].
-fn outages(s: &ScenarioSpec) -> Result<Vec<(f64, f64)>> {
+pub(crate) fn outages(s: &ScenarioSpec) -> Result<Vec<(f64, f64)>> {
     Ok(match &s.gnss {
         Some(g) => g
             .model()?

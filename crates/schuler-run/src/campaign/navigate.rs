@@ -25,7 +25,7 @@ pub struct Navigated {
 
 /// The options that start a run at the simulated truth of its first sample (the
 /// carrier of the start), in nav's units (degrees), over the campaign's own.
-fn start_options(nav_options: &toml::Table, first: &NavRecord) -> toml::Table {
+pub(crate) fn start_options(nav_options: &toml::Table, first: &NavRecord) -> toml::Table {
     let (p, v, a) = (&first.pos, &first.v_n, &first.att);
     let triple = |x: [f64; 3]| toml::Value::Array(x.map(toml::Value::Float).to_vec());
     let mut options = nav_options.clone();
