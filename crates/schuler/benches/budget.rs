@@ -3,6 +3,12 @@
 //! 100 Hz for one hour with their truth, GNSS position and velocity every second but
 //! for a 60-s outage every 10 minutes, the tactical preset with scale factors (12 model
 //! sources and the two GNSS noises, 14 in all: more than the goal's 10).
+//!
+//! Measured once: 3.9 s (3.81–3.98) on the shared 2-core VM while other builds ran
+//! (load average 4.5–7), so the 2-s goal is not shown met. The work is per second of
+//! data, not per sample: 14 propagations `Φ Pᵢ Φᵀ` of 21 states, the filter's own
+//! `transition` once more for each of the 6 sources with process noise, and two
+//! Joseph updates for each of the 14 (position, then velocity).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
