@@ -24,6 +24,11 @@ Messages (REP 103 body axes FLU, REP 105 world ENU):
              sqrt(vn^2 + ve^2 + vd^2) of truth.nav at the times that are multiples
              of 1/--odometer-rate (within 1e-6 of a period)
 
+With --imu-rpy R,P,Y [deg] the IMU frame imu_link is turned from base_link by tf2's
+RPY (fixed axes: R = Rz(Y) Ry(P) Rx(R)): a latched /tf_static (tf2_msgs/msg/TFMessage)
+holds base_link -> imu_link, and every IMU vector is written in imu_link's axes,
+v_imu = R^T v_base (base_link FLU, REP 103).
+
 Stamps: sec = floor(t), nanosec = the rest in ns; log time = stamp + --latency
 (GNSS, baro, odometry arrive late, as recorded on a robot), messages in log-time
 order. The same inputs and options give the same bytes.
@@ -74,6 +79,55 @@ ODOM_DEF = definition(
     "MSG: geometry_msgs/Pose\nPoint position\nQuaternion orientation\n",
     "MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n",
     QUATERNION, TWIST_COV, TWIST, VECTOR3)
+
+TF_DEF = definition(
+    "geometry_msgs/TransformStamped[] transforms\n",
+    "MSG: geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\n"
+    "Transform transform\n",
+    HEADER, TIME,
+    "MSG: geometry_msgs/Transform\nVector3 translation\nQuaternion rotation\n",
+    VECTOR3, QUATERNION)
+
+
+def rpy_quaternion(roll, pitch, yaw):
+    """x, y, z, w of R = Rz(yaw) Ry(pitch) Rx(roll) (tf2's setRPY)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+def transposed_matrix(q):
+    """R(q)^T as rows (pure Python, so that the bytes do not depend on numpy)."""
+    x, y, z, w = q
+    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    return [[r[j][i] for j in range(3)] for i in range(3)]
+
+
+def turned(msg, rt):
+    """The IMU message with its vectors in imu_link's axes (rt = R^T)."""
+    for key in ("angular_velocity", "linear_acceleration"):
+        v = msg[key]
+        b = (v["x"], v["y"], v["z"])
+        x, y, z = (sum(rt[i][j] * b[j] for j in range(3)) for i in range(3))
+        msg[key] = {"x": x, "y": y, "z": z}
+    return msg
+
+
+def tf_static(log_ns, q):
+    """The /tf_static message base_link -> imu_link (rotation q, x y z w)."""
+    return (log_ns, "/tf_static", {"transforms": [{
+        "header": {"stamp": {"sec": log_ns // 1_000_000_000,
+                             "nanosec": log_ns % 1_000_000_000},
+                   "frame_id": "base_link"},
+        "child_frame_id": "imu_link",
+        "transform": {"translation": {"x": 0.5, "y": 0.0, "z": 1.0},
+                      "rotation": dict(zip("xyzw", q))},
+    }]})
+
 
 # ISA troposphere, U.S. Standard Atmosphere 1976.
 P0, T0, LAPSE = 101325.0, 288.15, 0.0065
@@ -211,6 +265,7 @@ def main():
     p.add_argument("--gyro-std", type=float, help="one sample's gyro std [rad/s]")
     p.add_argument("--accel-std", type=float, help="one sample's accel std [m/s^2]")
     p.add_argument("--no-baro", action="store_true")
+    p.add_argument("--imu-rpy", help="imu_link's roll, pitch, yaw from base_link [deg]")
     a = p.parse_args()
     latency_ns = round(a.latency * 1e9)
     streams = [imu_messages(f"{a.sim}/imu.txt", a.gyro_std, a.accel_std),
@@ -222,6 +277,11 @@ def main():
     messages = [m for s in streams for m in s]
     # Log-time order; ties keep the order above (IMU first), as sorted() is stable.
     messages.sort(key=lambda m: m[0])
+    if a.imu_rpy:
+        q = rpy_quaternion(*(math.radians(float(x)) for x in a.imu_rpy.split(",")))
+        rt = transposed_matrix(q)
+        messages = [(n, t, turned(m, rt) if t == "/imu/data" else m) for n, t, m in messages]
+        messages.insert(0, tf_static(messages[0][0], q))
     compression = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
                    "none": CompressionType.NONE}[a.compression]
     with open(a.out, "wb") as f:
@@ -234,6 +294,8 @@ def main():
             "/baro": w.register_msgdef("sensor_msgs/msg/FluidPressure", PRESSURE_DEF),
             "/odom": w.register_msgdef("nav_msgs/msg/Odometry", ODOM_DEF),
         }
+        if a.imu_rpy:
+            schemas["/tf_static"] = w.register_msgdef("tf2_msgs/msg/TFMessage", TF_DEF)
         for seq, (log_ns, topic, msg) in enumerate(messages):
             w.write_message(topic, schemas[topic], msg, log_time=log_ns,
                             publish_time=log_ns, sequence=seq)

@@ -474,7 +474,11 @@ fn malformed_bags_are_named() {
     write_bag(&json, &[("/imu", IMU, "json")], 10, |i| at_rest(i).encode());
     let e = refused(&json, &[]);
     assert!(
-        e.contains("json.mcap: topic /imu: message encoding \"json\": only ROS 2 CDR"),
+        e.contains(
+            "json.mcap: topic /imu: message encoding \"json\" with schema encoding \
+             \"ros2msg\": only ROS 2 CDR (\"cdr\" with \"ros2msg\" or \"ros2idl\") and ROS 1 \
+             bags are read"
+        ),
         "{e}"
     );
     // A NaN in message 5, a payload cut short in message 7.

@@ -310,3 +310,279 @@ fn the_result_bag_reads_back_in_python() {
         rows[0][9]
     );
 }
+
+/// Our reader's values of one message (the fields it decodes), each with its index in
+/// `read_ros1_bag.py`'s list (which also holds the IMU's orientation and the twist's
+/// angular part, which our decoder skips), and the frame.
+fn our_values(type_name: &str, data: &[u8]) -> Option<(Vec<(usize, f64)>, String)> {
+    let (from, v, frame) = our_decoded(type_name, data)?;
+    let at = |i: usize| {
+        if type_name.ends_with("TwistWithCovarianceStamped") && i >= 3 {
+            i + 3
+        } else {
+            from + i
+        }
+    };
+    Some((
+        v.into_iter().enumerate().map(|(i, x)| (at(i), x)).collect(),
+        frame,
+    ))
+}
+
+/// The values our decoder gives, the index of the first in rosbags' list, the frame.
+fn our_decoded(type_name: &str, data: &[u8]) -> Option<(usize, Vec<f64>, String)> {
+    use schuler_io::bag::messages::{
+        Decode, Encoding, FluidPressure, Imu, NavSatFix, Odometry, TfMessage, TwistStamped,
+    };
+    let e = Encoding::Ros1;
+    let short = type_name.replace("/msg/", "/");
+    let decoded = match short.as_str() {
+        "sensor_msgs/Imu" => {
+            let m = Imu::decode_in(e, data).expect("imu");
+            let v = [
+                &m.angular_velocity[..],
+                &m.angular_velocity_covariance,
+                &m.linear_acceleration,
+                &m.linear_acceleration_covariance,
+            ]
+            .concat();
+            (13, v, m.header.frame_id)
+        }
+        "sensor_msgs/NavSatFix" => {
+            let m = NavSatFix::decode_in(e, data).expect("fix");
+            let mut v = vec![
+                f64::from(m.status),
+                f64::from(m.service),
+                m.latitude,
+                m.longitude,
+                m.altitude,
+            ];
+            v.extend(m.position_covariance);
+            v.push(f64::from(m.position_covariance_type));
+            (0, v, m.header.frame_id)
+        }
+        "geometry_msgs/TwistWithCovarianceStamped" => {
+            let m = TwistStamped::decode_in(e, data).expect("twist");
+            // linear, then (after the angular part) the covariance.
+            let mut v = m.linear.to_vec();
+            v.extend(m.covariance);
+            (0, v, m.header.frame_id)
+        }
+        "sensor_msgs/FluidPressure" => {
+            let m = FluidPressure::decode_in(e, data).expect("pressure");
+            (0, vec![m.fluid_pressure, m.variance], m.header.frame_id)
+        }
+        "nav_msgs/Odometry" => {
+            let m = Odometry::decode_in(e, data).expect("odometry");
+            let v = [
+                &m.position[..],
+                &m.orientation,
+                &m.pose_covariance,
+                &m.linear,
+                &m.angular,
+                &m.twist_covariance,
+            ]
+            .concat();
+            (0, v, m.header.frame_id)
+        }
+        "tf2_msgs/TFMessage" => {
+            let m = TfMessage::decode_in(e, data).expect("tf");
+            let mut v = Vec::new();
+            for t in &m.transforms {
+                v.extend(t.translation);
+                v.extend(t.rotation);
+            }
+            let frame = m.transforms[0].header.frame_id.clone();
+            (0, v, frame)
+        }
+        _ => return None,
+    };
+    Some(decoded)
+}
+
+/// Every message of the ROS 1 bag `bag` our reader decodes, compared with what the
+/// `rosbags` package decodes: the same messages (topic, type, md5sum, index within the
+/// topic, log time), and each value the same 64 bits (both decode the same bytes: no
+/// tolerance); returns the messages compared. Each topic's order is compared (the
+/// index), not the order across topics: we read in file order, rosbags in log-time
+/// order through the index, and messages of two topics logged at the same time (the
+/// /tf_static that write_test_ros1_bag.py writes with the first IMU message) may come
+/// in either order.
+fn same_as_rosbags(py: &Path, bag: &Path) -> usize {
+    use schuler_io::bag::container::BagStream;
+    let out = Command::new(py)
+        .arg(script("read_ros1_bag.py"))
+        .arg(bag)
+        .output()
+        .expect("run python");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // rosbags' messages by topic and index.
+    let mut theirs: std::collections::HashMap<(String, u64), serde_json::Value> =
+        String::from_utf8(out.stdout)
+            .expect("utf-8")
+            .lines()
+            .map(|l| {
+                let t: serde_json::Value = serde_json::from_str(l).expect("json");
+                let key = (
+                    t["topic"].as_str().expect("topic").to_owned(),
+                    t["index"].as_u64().expect("index"),
+                );
+                (key, t)
+            })
+            .collect();
+    let mut stream = BagStream::open(bag).expect("open");
+    let mut k = 0;
+    while let Some(()) = stream
+        .next_with(|m| {
+            let Some((ours, frame)) = our_values(&m.topic.type_name, m.data) else {
+                return Ok(());
+            };
+            let what = format!("{} message {}", m.topic.name, m.index);
+            let t = theirs
+                .remove(&(m.topic.name.clone(), m.index))
+                .unwrap_or_else(|| panic!("{what}: not among rosbags' messages"));
+            k += 1;
+            assert_eq!(
+                t["type"]
+                    .as_str()
+                    .map(|s| s.replace("/msg/", "/"))
+                    .as_deref(),
+                Some(m.topic.type_name.as_str()),
+                "{what}"
+            );
+            assert_eq!(t["md5sum"], m.topic.md5sum.as_str(), "{what}");
+            assert_eq!(t["log_time"].as_u64(), Some(m.log_time), "{what}");
+            assert_eq!(t["frame_id"], frame.as_str(), "{what}");
+            let bits: Vec<u64> = t["bits"]
+                .as_array()
+                .expect("bits")
+                .iter()
+                .map(|b| b.as_u64().expect("u64"))
+                .collect();
+            assert_eq!(ours.last().map(|(i, _)| i + 1), Some(bits.len()), "{what}");
+            for (i, x) in ours {
+                assert_eq!(x.to_bits(), bits[i], "{what}: value {i}");
+            }
+            Ok(())
+        })
+        .expect("read")
+    {}
+    assert!(
+        theirs.is_empty(),
+        "{} of rosbags' messages not read by ours",
+        theirs.len()
+    );
+    k
+}
+
+/// robot_localization's test2.bag (rosbag's own bz2 chunks) and its first 5 s in
+/// uncompressed, bz2 and lz4 chunks: 6121 and 501 messages, every value as rosbags
+/// reads it.
+#[test]
+fn the_ros1_reader_agrees_with_rosbags_value_by_value() {
+    let Some(py) = python() else { return };
+    let data = common::test_data("ros1_bag");
+    assert_eq!(same_as_rosbags(&py, &data.join("test2.bag")), 6121);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let none = dir.path().join("test2_first5s_none.bag");
+    std::fs::write(&none, common::unxz(&data.join("test2_first5s_none.bag.xz"))).expect("write");
+    for path in [
+        none,
+        data.join("test2_first5s_bz2.bag"),
+        data.join("test2_first5s_lz4.bag"),
+    ] {
+        assert_eq!(same_as_rosbags(&py, &path), 501, "{}", path.display());
+    }
+}
+
+/// `write_test_ros1_bag.py sim out` with `extra`, which must succeed.
+fn write_ros1_bag(python: &Path, sim: &Path, out: &Path, extra: &[&str]) {
+    let status = Command::new(python)
+        .arg(script("write_test_ros1_bag.py"))
+        .arg(sim)
+        .arg(out)
+        .args(extra)
+        .status()
+        .expect("run python");
+    assert!(status.success(), "write_test_ros1_bag.py failed: {status}");
+}
+
+/// The drive of `drive.mcap` written by rosbags as a ROS 1 bag whose IMU frame is
+/// rolled −90° and yawed 90° from base_link in /tf_static (the IMU's vectors turned
+/// into that frame by the script, with numpy): `nav --bag` takes the mounting from
+/// the transform tree and gives the MCAP bag's trajectory. The two inputs differ by
+/// the rounding of the turn there and back (the quaternion of cos/sin of 45°: ~1e-16
+/// relative on each rate), which the filter carries as the 1-ulp input differences
+/// of `the_example_drive_from_lz4_chunks_gives_the_text_trajectory`: bound 5 units of
+/// nav.txt's last digit. Every value of the written bag is also read as rosbags
+/// reads it; bz2, lz4 and uncompressed chunks give the same bits; the mounting given
+/// by hand as well is refused beside --base-frame and overrides the tree otherwise
+/// (the same mounting given by hand gives the same trajectory).
+#[test]
+fn a_ros1_bag_with_the_imu_turned_in_tf_static_gives_the_mcap_trajectory() {
+    let Some(py) = python() else { return };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sim = simulate_scenario(dir.path());
+    let turn = ["--odometer-rate", "10", "--imu-rpy=-90,0,90"];
+    let mut runs = Vec::new();
+    for compression in ["bz2", "lz4", "none"] {
+        let bag = dir.path().join(format!("drive_{compression}.bag"));
+        write_ros1_bag(
+            &py,
+            &sim,
+            &bag,
+            &[&turn[..], &["--compression", compression]].concat(),
+        );
+        let out = dir.path().join(compression);
+        let a = nav_bag(&bag, &out, &[]).success();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert!(
+            err.contains("IMU mounting from /tf_static: imu_link in base_link (FLU)"),
+            "{err}"
+        );
+        runs.push((bag, out));
+    }
+    assert!(same_as_rosbags(&py, &runs[0].0) > 9422);
+    let mcap = dir.path().join("mcap");
+    nav_bag(&data().join("drive.mcap"), &mcap, &[]).success();
+    let digits = max_digits_apart(&mcap.join("nav.txt"), &runs[0].1.join("nav.txt"));
+    assert!(digits <= 5.0, "{digits} units of the last digit apart");
+    for (_, out) in &runs[1..] {
+        assert_eq!(
+            std::fs::read(out.join("nav.txt")).expect("nav"),
+            std::fs::read(runs[0].1.join("nav.txt")).expect("nav")
+        );
+    }
+    let bag = &runs[0].0;
+    let out = dir.path().join("both");
+    let a = nav_bag(
+        bag,
+        &out,
+        &["--base-frame", "base_link", "--imu-axes", "FLU"],
+    )
+    .failure();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        err.contains("--base-frame base_link takes the IMU's mounting"),
+        "{err}"
+    );
+    // The same mounting by hand: imu_link = Rz(90°) Rx(−90°) from base_link (FLU)
+    // puts the IMU's x to the left, y down and z back (LDB), which overrides the tree
+    // with a warning and gives the trajectory the tree gave (bound as above).
+    let by_hand = dir.path().join("by_hand");
+    let a = nav_bag(bag, &by_hand, &["--imu-axes", "LDB"]).success();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        err.contains("override /tf_static's mounting in base_link"),
+        "{err}"
+    );
+    let digits = max_digits_apart(&mcap.join("nav.txt"), &by_hand.join("nav.txt"));
+    assert!(digits <= 5.0, "{digits} units of the last digit apart");
+    let a = nav_bag(bag, &out, &["--base-frame", "odom"]).failure();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("frame odom is not above imu_link"), "{err}");
+}

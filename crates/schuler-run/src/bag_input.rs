@@ -1,7 +1,9 @@
-//! A ROS 2 bag as a navigation run's input (`schuler nav --bag`) (its IMU, GNSS, velocity,
-//! barometer and odometry topics, [`schuler_io::bag::input`]) and `--out-bag`, the result as
-//! a bag ([`schuler_io::bag::output`]). The IMU's axes are FLU (REP 103) unless
-//! `--imu-axes`/`--imu-rotation` say otherwise; `--imu-time-offset` shifts every
+//! A ROS 1 or ROS 2 bag as a navigation run's input (`schuler nav --bag`) (its IMU, GNSS,
+//! velocity, barometer and odometry topics, [`schuler_io::bag::input`]) and `--out-bag`, the
+//! result as a bag ([`schuler_io::bag::output`]). The IMU's mounting comes from the bag's
+//! `/tf_static` (the IMU's frame up to `--base-frame`, default its parent), else its axes
+//! are FLU (REP 103); `--imu-axes`/`--imu-rotation` given by hand win over the transform
+//! tree (the run says so), and are refused together with `--base-frame`; `--imu-time-offset` shifts every
 //! topic's stamps (a bag has one clock); `--gnss-std` and `--gnss-vel-std` stand in
 //! for missing covariances; the IMU's covariances give the noise model where
 //! `--arw`/`--vrw` are not given.
@@ -18,9 +20,10 @@ use std::path::PathBuf;
 /// (`bag = "run.mcap"`, `imu_topic = "/imu/data"`, `out_bag = "nav.mcap"`; flags win).
 #[derive(clap::Args, Debug, Default, Clone, PartialEq)]
 pub struct BagArgs {
-    /// A ROS 2 bag (.mcap file or rosbag2 directory) as the input: sensor_msgs/Imu,
-    /// NavSatFix, FluidPressure, geometry_msgs/TwistWithCovarianceStamped (GNSS
-    /// velocity, ENU) and nav_msgs/Odometry topics, found by type.
+    /// A ROS bag as the input: ROS 1 (.bag, format 2.0) or ROS 2 (.mcap file or
+    /// rosbag2 directory), told by content: sensor_msgs/Imu, NavSatFix, FluidPressure,
+    /// geometry_msgs/TwistWithCovarianceStamped (GNSS velocity, ENU) and
+    /// nav_msgs/Odometry topics, found by type; the IMU's mounting from /tf_static.
     #[arg(long, value_name = "BAG", conflicts_with = "imu")]
     pub bag: Option<PathBuf>,
     /// The IMU topic, when the bag has several.
@@ -38,6 +41,11 @@ pub struct BagArgs {
     /// The Odometry topic (forward speed), when several.
     #[arg(long, value_name = "TOPIC")]
     pub odom_topic: Option<String>,
+    /// The robot's body frame in the bag's /tf_static (its axes FLU by REP 103): the
+    /// IMU's mounting is the rotation from the IMU messages' frame_id up to it
+    /// (default: the IMU frame's parent). Not with --imu-axes/--imu-rotation.
+    #[arg(long, value_name = "FRAME")]
+    pub base_frame: Option<String>,
     /// GPS - UTC [s] for a bag whose header stamps are UNIX time (default: the
     /// leap seconds of each stamp's date, 18 since 2017-01-01).
     #[arg(long, value_name = "SECONDS")]
@@ -58,6 +66,7 @@ impl BagArgs {
             gnss_vel_topic: self.gnss_vel_topic.or(other.gnss_vel_topic),
             baro_topic: self.baro_topic.or(other.baro_topic),
             odom_topic: self.odom_topic.or(other.odom_topic),
+            base_frame: self.base_frame.or(other.base_frame),
             out_bag: self.out_bag.or(other.out_bag),
             leap_seconds: self.leap_seconds.or(other.leap_seconds),
         }
@@ -78,6 +87,12 @@ impl BagArgs {
 pub fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<BagReadOptions> {
     let read = &plan.settings.read;
     let a = &plan.aiding;
+    if axes_given && let Some(frame) = &args.base_frame {
+        bail!(
+            "--base-frame {frame} takes the IMU's mounting from the bag's /tf_static; \
+             --imu-axes and --imu-rotation give it by hand: give one"
+        );
+    }
     let default_gnss_std = match a.gnss_std {
         Some(Triple(s)) if s.iter().all(|&x| x > 0.0) => Some(Vector3::from(s)),
         Some(Triple(s)) => bail!("--gnss-std must be positive, got {s:?}"),
@@ -99,6 +114,8 @@ pub fn read_options(plan: &NavPlan, args: &BagArgs, axes_given: bool) -> Result<
             (false, _) => flu_to_frd(),
             (true, c) => c.unwrap_or_else(nalgebra::Matrix3::identity),
         },
+        axes_given,
+        base_frame: args.base_frame.clone(),
         time_offset: read.time_offset,
         t_start: read.t_start,
         t_end: read.t_end,

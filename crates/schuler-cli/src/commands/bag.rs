@@ -1,5 +1,5 @@
-//! `schuler bag info FILE`: the topics of a ROS 2 bag (MCAP file or rosbag2
-//! directory) with their types, message counts, rates and log-time spans, and which
+//! `schuler bag info FILE`: the topics of a ROS bag (ROS 1 `.bag`, or ROS 2 MCAP
+//! file or rosbag2 directory, told by content) with their types, message counts, rates and log-time spans, and which
 //! of them `schuler nav --bag` would read.
 
 use anyhow::Result;
@@ -20,7 +20,7 @@ pub struct Args {
 pub enum BagCommand {
     /// List the topics: type, messages, rate, first and last log time.
     Info {
-        /// The bag: an .mcap file or a rosbag2 directory.
+        /// The bag: a ROS 1 .bag file, an .mcap file or a rosbag2 directory.
         #[arg(value_name = "BAG")]
         bag: PathBuf,
     },
@@ -35,7 +35,7 @@ pub fn run(args: Args) -> Result<()> {
             for kind in Kind::ALL {
                 let of_type: Vec<&str> = topics
                     .iter()
-                    .filter(|t| t.topic.type_name == kind.type_name())
+                    .filter(|t| Kind::of_type(&t.topic.type_name) == Some(kind))
                     .map(|t| t.topic.name.as_str())
                     .collect();
                 match of_type[..] {

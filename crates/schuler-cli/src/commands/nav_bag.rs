@@ -1,11 +1,11 @@
-//! `schuler nav --bag`: a ROS 2 bag as the run's input
+//! `schuler nav --bag`: a ROS 1 or ROS 2 bag as the run's input
 //! ([`schuler_run::bag_input`]), what it holds and the noise its covariances give told
 //! on stderr.
 
 use super::nav::{navigate_printing, print_summary};
 use anyhow::{Result, bail};
 use indicatif::ProgressBar;
-use schuler_io::bag::input::{BagPlan, Kind};
+use schuler_io::bag::input::{BagPlan, Kind, Mounting};
 use schuler_run::bag_input::{plan_bag, read_options};
 use schuler_run::nav::{NavPlan, filter_grade};
 use std::time::Instant;
@@ -32,12 +32,43 @@ fn describe(p: &BagPlan) {
         p.aids.baro.len(),
         p.aids.odometer.len()
     );
+    describe_mounting(p);
     if p.aids.unmatched_velocities > 0 {
         eprintln!(
             "warning: {}: {} velocity messages have no fix at the same stamp and are not used",
             p.path.display(),
             p.aids.unmatched_velocities
         );
+    }
+}
+
+/// Where the IMU's axes came from, as the `--imu-rotation` that gives the same.
+fn describe_mounting(p: &BagPlan) {
+    let path = p.path.display();
+    let e = schuler::rotation::Euler::from_dcm(&p.c_vs);
+    let as_flag = format!(
+        "--imu-rotation {:.6},{:.6},{:.6}",
+        e.roll.to_degrees(),
+        e.pitch.to_degrees(),
+        e.yaw.to_degrees()
+    );
+    match &p.mounting {
+        Mounting::Tf {
+            imu_frame,
+            base_frame,
+        } => eprintln!(
+            "{path}: IMU mounting from /tf_static: {imu_frame} in {base_frame} (FLU), as {as_flag}"
+        ),
+        Mounting::Given {
+            tf_ignored: Some(base),
+        } => eprintln!(
+            "warning: {path}: the IMU's axes given by hand ({as_flag}) override /tf_static's mounting in {base}"
+        ),
+        Mounting::Given { tf_ignored: None } => {}
+        Mounting::Flu { imu_frame } => eprintln!(
+            "{path}: IMU axes FLU (REP 103): /tf_static does not place its frame {}",
+            imu_frame.as_deref().unwrap_or("(none)")
+        ),
     }
 }
 

@@ -85,19 +85,6 @@ impl<'a> CdrReader<'a> {
         self.take::<8>(field).map(f64::from_le_bytes)
     }
 
-    /// A `float64` that must be finite.
-    pub fn finite(&mut self, field: &str) -> Result<f64, CdrError> {
-        let x = self.f64(field)?;
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(CdrError {
-                field: field.to_owned(),
-                reason: format!("{x} is not a finite number"),
-            })
-        }
-    }
-
     /// An `int32`.
     pub fn i32(&mut self, field: &str) -> Result<i32, CdrError> {
         self.take::<4>(field).map(i32::from_le_bytes)
@@ -148,21 +135,6 @@ impl<'a> CdrReader<'a> {
         String::from_utf8(text.to_vec()).map_err(|_| err("string is not UTF-8".into()))
     }
 
-    /// `N` `float64`s (a fixed array), each finite.
-    pub fn finite_array<const N: usize>(&mut self, field: &str) -> Result<[f64; N], CdrError> {
-        let mut out = [0.0; N];
-        for (i, x) in out.iter_mut().enumerate() {
-            *x = self.f64(field)?;
-            if !x.is_finite() {
-                return Err(CdrError {
-                    field: format!("{field}[{i}]"),
-                    reason: format!("{x} is not a finite number"),
-                });
-            }
-        }
-        Ok(out)
-    }
-
     /// Skips `n` `float64`s (a fixed array not used), with one bounds check.
     pub fn skip_f64s(&mut self, n: usize, field: &str) -> Result<(), CdrError> {
         let start = self.pos.next_multiple_of(8);
@@ -188,6 +160,43 @@ impl<'a> CdrReader<'a> {
         }
         self.pos = end;
         Ok(())
+    }
+}
+
+impl super::wire::WireReader for CdrReader<'_> {
+    fn f64(&mut self, field: &str) -> Result<f64, CdrError> {
+        CdrReader::f64(self, field)
+    }
+    fn i32(&mut self, field: &str) -> Result<i32, CdrError> {
+        CdrReader::i32(self, field)
+    }
+    fn u32(&mut self, field: &str) -> Result<u32, CdrError> {
+        CdrReader::u32(self, field)
+    }
+    fn u16(&mut self, field: &str) -> Result<u16, CdrError> {
+        CdrReader::u16(self, field)
+    }
+    fn i8(&mut self, field: &str) -> Result<i8, CdrError> {
+        CdrReader::i8(self, field)
+    }
+    fn u8(&mut self, field: &str) -> Result<u8, CdrError> {
+        CdrReader::u8(self, field)
+    }
+    fn string(&mut self, field: &str) -> Result<String, CdrError> {
+        CdrReader::string(self, field)
+    }
+    fn skip_string(&mut self, field: &str) -> Result<(), CdrError> {
+        CdrReader::skip_string(self, field)
+    }
+    fn skip_f64s(&mut self, n: usize, field: &str) -> Result<(), CdrError> {
+        CdrReader::skip_f64s(self, n, field)
+    }
+    /// `builtin_interfaces/Time`: `int32 sec`, `uint32 nanosec`.
+    fn header_stamp(&mut self) -> Result<(i32, u32), CdrError> {
+        Ok((
+            CdrReader::i32(self, "header.stamp.sec")?,
+            CdrReader::u32(self, "header.stamp.nanosec")?,
+        ))
     }
 }
 
@@ -265,6 +274,7 @@ impl CdrWriter {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bag::wire::WireReader;
 
     /// The bytes of a `std_msgs/Header` then a `float64` by the rules of the module
     /// doc, written out by hand: the string (length 5 with its NUL) ends at body byte

@@ -1,4 +1,5 @@
-//! The MCAP container of a bag, read front to back in constant memory: a single
+//! The container of a bag, read front to back in constant memory, told by its
+//! content: a ROS 1 bag (`#ROSBAG V2.0`, [`super::ros1`]), else MCAP: a single
 //! `.mcap` file, or a rosbag2 directory (its `metadata.yaml` names the `.mcap` files in
 //! order). The `mcap` crate's streaming reader checks every chunk's CRC and
 //! decompresses zstd and lz4 chunks; here each message is paired with its channel
@@ -23,8 +24,26 @@ pub struct Topic {
     pub type_name: String,
     /// Schema encoding (`ros2msg`, `ros2idl`).
     pub schema_encoding: String,
-    /// Message encoding (`cdr`).
+    /// Message encoding (`cdr`; `ros1` for a ROS 1 bag).
     pub message_encoding: String,
+    /// The MD5 sum of the message definition (ROS 1 bags; empty for MCAP).
+    pub md5sum: String,
+}
+
+impl Topic {
+    /// The serialization of its messages, when schuler reads it: ROS 2 CDR with a
+    /// ROS 2 definition, or ROS 1's; `None` for another.
+    pub fn encoding(&self) -> Option<super::wire::Encoding> {
+        use super::wire::Encoding;
+        match (
+            self.message_encoding.as_str(),
+            self.schema_encoding.as_str(),
+        ) {
+            ("cdr", "ros2msg" | "ros2idl") => Some(Encoding::Cdr),
+            ("ros1", "ros1msg") => Some(Encoding::Ros1),
+            _ => None,
+        }
+    }
 }
 
 /// One message as it comes: its topic, its 1-based index within the topic, its log
@@ -201,8 +220,8 @@ struct OpenFile {
     reader: LinearReader,
 }
 
-/// Reads every message of a bag in file order.
-pub struct BagStream {
+/// Reads every message of an MCAP bag in file order.
+pub struct McapStream {
     files: Vec<PathBuf>,
     next_file: usize,
     open: Option<OpenFile>,
@@ -210,7 +229,7 @@ pub struct BagStream {
     bytes: u64,
 }
 
-impl BagStream {
+impl McapStream {
     /// Opens the bag at `path` (a `.mcap` file or a rosbag2 directory).
     pub fn open(path: &Path) -> Result<Self, BagError> {
         Ok(Self {
@@ -320,5 +339,69 @@ fn channel_topic(
         type_name,
         schema_encoding,
         message_encoding: c.message_encoding.clone(),
+        md5sum: String::new(),
     })
+}
+
+/// Reads every message of a bag, ROS 1 or MCAP, in file order. Both streams are
+/// boxed (one allocation per bag opened), so that the enum is a pointer's size
+/// whichever it holds.
+pub enum BagStream {
+    /// A ROS 1 bag (format 2.0).
+    Ros1(Box<super::ros1::Ros1Stream>),
+    /// An MCAP file or rosbag2 directory.
+    Mcap(Box<McapStream>),
+}
+
+/// Whether the file at `path` opens with `#ROSBAG` (a ROS 1 bag of any version).
+fn is_ros1(path: &Path) -> Result<bool, BagError> {
+    if path.is_dir() {
+        return Ok(false);
+    }
+    let mut head = [0u8; 8];
+    let mut f = File::open(path).map_err(|e| BagError::file(path, format!("cannot open: {e}")))?;
+    let n = f
+        .read(&mut head)
+        .map_err(|e| BagError::file(path, e.to_string()))?;
+    Ok(&head[..n] == b"#ROSBAG ")
+}
+
+impl BagStream {
+    /// Opens the bag at `path`: a ROS 1 bag (told by its first line), else MCAP (a
+    /// `.mcap` file or a rosbag2 directory).
+    pub fn open(path: &Path) -> Result<Self, BagError> {
+        if is_ros1(path)? {
+            super::ros1::Ros1Stream::open(path).map(|s| BagStream::Ros1(Box::new(s)))
+        } else {
+            McapStream::open(path).map(|s| BagStream::Mcap(Box::new(s)))
+        }
+    }
+
+    /// Bytes read from the files so far.
+    pub fn bytes_read(&self) -> u64 {
+        match self {
+            BagStream::Ros1(s) => s.bytes_read(),
+            BagStream::Mcap(s) => s.bytes_read(),
+        }
+    }
+
+    /// Total size of the bag's files [bytes].
+    pub fn total_bytes(&self) -> u64 {
+        match self {
+            BagStream::Ros1(s) => s.total_bytes(),
+            BagStream::Mcap(s) => s.total_bytes(),
+        }
+    }
+
+    /// The next message, handed to `f`; `Ok(None)` at the end of the bag. After an
+    /// error the stream ends.
+    pub fn next_with<R>(
+        &mut self,
+        f: impl FnMut(Message) -> Result<R, BagError>,
+    ) -> Result<Option<R>, BagError> {
+        match self {
+            BagStream::Ros1(s) => s.next_with(f),
+            BagStream::Mcap(s) => s.next_with(f),
+        }
+    }
 }

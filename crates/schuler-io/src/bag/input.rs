@@ -18,6 +18,14 @@
 //! - `sensor_msgs/FluidPressure` [Pa]: the height of the ISA troposphere
 //!   ([`isa_height`]).
 //! - `nav_msgs/Odometry`: the forward speed `twist.twist.linear.x` of the child frame.
+//! - `tf2_msgs/TFMessage` on `/tf_static`: the IMU's mounting ([`Mounting`],
+//!   [`super::tf`]): the rotation from the IMU message's `frame_id` up to the base
+//!   frame (`--base-frame`, default the IMU frame's parent), then FLU to FRD, unless
+//!   the IMU's axes are given by hand.
+//!
+//! ROS 1 bags and ROS 2 bags read alike: the types match as `pkg/Name` or
+//! `pkg/msg/Name`, and each topic's messages decode in its own serialization
+//! ([`Encoding`]).
 //!
 //! Every time is the header stamp on the run's clock ([`StampClock`]: UNIX stamps as
 //! GPS seconds of week, stamps before 1980 as they are) plus
@@ -28,9 +36,10 @@ use super::clock::StampClock;
 use super::container::{BagStream, Message, Topic};
 use super::info::{TopicSummary, scan};
 use super::messages::{
-    FLUID_PRESSURE, FluidPressure, IMU, Imu, ImuMotion, NAV_SAT_FIX, NavSatFix, ODOMETRY, Odometry,
-    STATUS_NO_FIX, TWIST, TwistStamped,
+    Decode, Encoding, FLUID_PRESSURE, FluidPressure, IMU, Imu, ImuMotion, NAV_SAT_FIX, NavSatFix,
+    ODOMETRY, Odometry, STATUS_NO_FIX, TF_MESSAGE, TWIST, TfMessage, TwistStamped, same_type,
 };
+use super::tf::{TfTree, frame_name};
 use crate::formats::imu_log::{GAP_FACTOR, GapReport};
 use nalgebra::{Matrix3, Vector3};
 use schuler::domain;
@@ -91,6 +100,40 @@ impl Kind {
     fn index(self) -> usize {
         self as usize
     }
+
+    /// The kind whose type `type_name` is (ROS 1 or ROS 2 spelling).
+    pub fn of_type(type_name: &str) -> Option<Kind> {
+        Kind::ALL
+            .into_iter()
+            .find(|k| same_type(type_name, k.type_name()))
+    }
+}
+
+/// The topic the static transforms are read from.
+pub const TF_STATIC: &str = "/tf_static";
+
+/// Where the IMU's axes were taken from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Mounting {
+    /// The bag's `/tf_static`: the IMU message's frame up to the base frame.
+    Tf {
+        /// The IMU messages' `frame_id`.
+        imu_frame: String,
+        /// The base frame (FLU).
+        base_frame: String,
+    },
+    /// `--imu-axes`/`--imu-rotation`, over the transform tree's when it had the IMU's
+    /// frame (`tf_ignored`: that frame's parent).
+    Given {
+        /// The base frame the tree would have given.
+        tf_ignored: Option<String>,
+    },
+    /// REP 103: the IMU's axes FLU, as the tree does not place the IMU's frame
+    /// (`imu_frame`, when the messages name one).
+    Flu {
+        /// The IMU messages' `frame_id`.
+        imu_frame: Option<String>,
+    },
 }
 
 /// How a bag is read.
@@ -99,8 +142,14 @@ pub struct BagReadOptions {
     /// The topic of each [`Kind`] (by [`Kind::index`]) when named; `"none"` reads none.
     pub topics: [Option<String>; 5],
     /// From the IMU message's axes to the vehicle's FRD (FLU by default:
-    /// `diag(1, −1, −1)`).
+    /// `diag(1, −1, −1)`), used when `axes_given` or when `/tf_static` does not place
+    /// the IMU's frame.
     pub c_vs: Matrix3<f64>,
+    /// Whether `c_vs` was given by hand (then it wins over `/tf_static`).
+    pub axes_given: bool,
+    /// The base frame of the mounting from `/tf_static` (`None`: the parent of the
+    /// IMU's frame); an error when `axes_given`.
+    pub base_frame: Option<String>,
     /// Seconds added to every stamp.
     pub time_offset: f64,
     /// First and last IMU time read [s, after the offset].
@@ -122,6 +171,8 @@ impl Default for BagReadOptions {
         Self {
             topics: Default::default(),
             c_vs: flu_to_frd(),
+            axes_given: false,
+            base_frame: None,
             time_offset: 0.0,
             t_start: None,
             t_end: None,
@@ -133,10 +184,7 @@ impl Default for BagReadOptions {
     }
 }
 
-/// FLU (REP 103) to FRD: `diag(1, −1, −1)`.
-pub fn flu_to_frd() -> Matrix3<f64> {
-    Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0))
-}
+pub use super::tf::flu_to_frd;
 
 /// The aids a bag holds, in the session's frames and units.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -170,6 +218,8 @@ struct Gathered {
     /// The first messages' angular rates and specific forces (IMU axes).
     imu_motion: Vec<([f64; 3], [f64; 3])>,
     imu_covariance: Option<([f64; 9], [f64; 9])>,
+    /// The first IMU message's `frame_id`.
+    imu_frame: Option<String>,
     fixes: Vec<(u64, NavSatFix)>,
     twists: Vec<(u64, TwistStamped)>,
     pressures: Vec<(u64, FluidPressure)>,
@@ -196,66 +246,76 @@ pub struct BagPlan {
     pub imu_noise: Option<(Vector3<f64>, Vector3<f64>)>,
     /// The aids.
     pub aids: BagAids,
+    /// Where the IMU's axes come from.
+    pub mounting: Mounting,
+    /// From the IMU's axes to FRD, as [`Self::mounting`] gives it.
+    pub c_vs: Matrix3<f64>,
     options: BagReadOptions,
 }
 
-/// Whether `topic` is decodable as ROS 2 CDR: schema `ros2msg`/`ros2idl`, messages
-/// `cdr`.
-fn check_encoding(path: &Path, topic: &Topic) -> Result<(), BagError> {
-    if topic.message_encoding != "cdr" {
-        return Err(BagError::topic(
+/// The serialization of `topic`'s messages: ROS 2 CDR (schema `ros2msg`/`ros2idl`,
+/// messages `cdr`) or ROS 1 (`ros1msg`, `ros1`); another is an error.
+fn check_encoding(path: &Path, topic: &Topic) -> Result<Encoding, BagError> {
+    topic.encoding().ok_or_else(|| {
+        BagError::topic(
             path,
             &topic.name,
             0,
             None,
             format!(
-                "message encoding {:?}: only ROS 2 CDR (\"cdr\") is read",
-                topic.message_encoding
+                "message encoding {:?} with schema encoding {:?}: only ROS 2 CDR (\"cdr\" with \
+                 \"ros2msg\" or \"ros2idl\") and ROS 1 bags are read",
+                topic.message_encoding, topic.schema_encoding
             ),
-        ));
-    }
-    if !matches!(topic.schema_encoding.as_str(), "ros2msg" | "ros2idl") {
-        return Err(BagError::topic(
-            path,
-            &topic.name,
-            0,
-            None,
-            format!(
-                "schema encoding {:?}: only ROS 2 message definitions (\"ros2msg\", \"ros2idl\") are read",
-                topic.schema_encoding
-            ),
-        ));
-    }
-    Ok(())
+        )
+    })
 }
 
-/// Stores message `m` of a kind we read in `g` (decoding errors kept, not raised).
-fn gather(path: &Path, m: &Message, g: &mut Gathered) {
-    if g.error.is_some() || check_encoding(path, m.topic).is_err() {
+/// Stores message `m` of kind `kind` in `g` (decoding errors kept, not raised).
+fn gather(path: &Path, m: &Message, kind: Kind, g: &mut Gathered) {
+    if g.error.is_some() {
         return;
     }
+    let Ok(enc) = check_encoding(path, m.topic) else {
+        return;
+    };
     let err = |e| BagError::decode(path, &m.topic.name, m.index, e);
-    let result = match m.topic.type_name.as_str() {
-        IMU if g.imu_stamps.len() <= LOOKAHEAD => Imu::decode(m.data).map(|imu| {
+    let result = match kind {
+        Kind::Imu if g.imu_stamps.len() <= LOOKAHEAD => Imu::decode_in(enc, m.data).map(|imu| {
             if g.imu_covariance.is_none() && imu.angular_velocity_covariance[0] > 0.0 {
                 g.imu_covariance = Some((
                     imu.angular_velocity_covariance,
                     imu.linear_acceleration_covariance,
                 ));
             }
+            if g.imu_frame.is_none() {
+                g.imu_frame = Some(imu.header.frame_id.clone());
+            }
             g.imu_stamps.push((imu.header.sec, imu.header.nanosec));
             g.imu_motion
                 .push((imu.angular_velocity, imu.linear_acceleration));
         }),
-        NAV_SAT_FIX => NavSatFix::decode(m.data).map(|x| g.fixes.push((m.index, x))),
-        TWIST => TwistStamped::decode(m.data).map(|x| g.twists.push((m.index, x))),
-        FLUID_PRESSURE => FluidPressure::decode(m.data).map(|x| g.pressures.push((m.index, x))),
-        ODOMETRY => Odometry::decode(m.data).map(|x| g.odometry.push((m.index, x))),
-        _ => Ok(()),
+        Kind::Imu => Ok(()),
+        Kind::Gnss => NavSatFix::decode_in(enc, m.data).map(|x| g.fixes.push((m.index, x))),
+        Kind::GnssVel => TwistStamped::decode_in(enc, m.data).map(|x| g.twists.push((m.index, x))),
+        Kind::Baro => FluidPressure::decode_in(enc, m.data).map(|x| g.pressures.push((m.index, x))),
+        Kind::Odometry => Odometry::decode_in(enc, m.data).map(|x| g.odometry.push((m.index, x))),
     };
     if let Err(e) = result {
         g.error = Some(err(e));
     }
+}
+
+/// Takes the transforms of a `/tf_static` message into `tree`.
+fn gather_tf(path: &Path, m: &Message, tree: &mut TfTree) -> Result<(), BagError> {
+    let enc = check_encoding(path, m.topic)?;
+    let tf = TfMessage::decode_in(enc, m.data)
+        .map_err(|e| BagError::decode(path, &m.topic.name, m.index, e))?;
+    for t in &tf.transforms {
+        tree.insert(t)
+            .map_err(|(f, e)| BagError::topic(path, &m.topic.name, m.index, Some(&f), e))?;
+    }
+    Ok(())
 }
 
 /// The topic of `kind`: the one named (`"none"`: no topic), else the only one of its
@@ -268,7 +328,7 @@ fn choose(
 ) -> Result<Option<String>, BagError> {
     let of_type: Vec<&str> = topics
         .iter()
-        .filter(|t| t.topic.type_name == kind.type_name())
+        .filter(|t| same_type(&t.topic.type_name, kind.type_name()))
         .map(|t| t.topic.name.as_str())
         .collect();
     match named {
@@ -285,7 +345,7 @@ fn choose(
                     ),
                 ));
             };
-            if t.topic.type_name != kind.type_name() {
+            if !same_type(&t.topic.type_name, kind.type_name()) {
                 return Err(BagError::topic(
                     path,
                     name,
@@ -337,25 +397,32 @@ fn list(names: &[&str]) -> String {
 /// The first pass over the bag at `path`: topics, the chosen ones, the IMU's
 /// interval and noise, the aids.
 pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> {
-    let mut by_place: Vec<Option<Gathered>> = Vec::new();
-    let known = Kind::ALL.map(Kind::type_name);
+    let mut by_place: Vec<Option<(Kind, Gathered)>> = Vec::new();
+    // Each topic's kind, by its place, settled at its first message.
+    let mut kinds: Vec<Option<Option<Kind>>> = Vec::new();
     let mut names: HashMap<usize, String> = HashMap::new();
+    let mut tree = TfTree::default();
     let topics = scan(path, |m| {
-        if known.contains(&m.topic.type_name.as_str()) {
-            if by_place.len() <= m.topic_index {
-                by_place.resize_with(m.topic_index + 1, || None);
-            }
-            let g = by_place[m.topic_index].get_or_insert_with(|| {
-                names.insert(m.topic_index, m.topic.name.clone());
-                Gathered::default()
+        let place = m.topic_index;
+        if kinds.len() <= place {
+            kinds.resize(place + 1, None);
+            by_place.resize_with(place + 1, || None);
+        }
+        let kind = *kinds[place].get_or_insert_with(|| Kind::of_type(&m.topic.type_name));
+        if let Some(kind) = kind {
+            let (_, g) = by_place[place].get_or_insert_with(|| {
+                names.insert(place, m.topic.name.clone());
+                (kind, Gathered::default())
             });
-            gather(path, m, g);
+            gather(path, m, kind, g);
+        } else if m.topic.name == TF_STATIC && same_type(&m.topic.type_name, TF_MESSAGE) {
+            gather_tf(path, m, &mut tree)?;
         }
         Ok(())
     })?;
     let mut gathered: HashMap<String, Gathered> = HashMap::new();
     for (place, g) in by_place.into_iter().enumerate() {
-        if let (Some(g), Some(name)) = (g, names.remove(&place)) {
+        if let (Some((_, g)), Some(name)) = (g, names.remove(&place)) {
             gathered.insert(name, g);
         }
     }
@@ -385,9 +452,10 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
     };
     let imu = take(Kind::Imu)?;
     let (clock, nominal_dt) = imu_clock(path, &imu_topic, &imu, options)?;
+    let (mounting, c_vs) = mounting(path, &imu_topic, imu.imu_frame.as_deref(), &tree, options)?;
     let imu_noise = imu
         .imu_covariance
-        .map(|(w, f)| noise_from_covariance(&w, &f, &options.c_vs, nominal_dt));
+        .map(|(w, f)| noise_from_covariance(&w, &f, &c_vs, nominal_dt));
     let gathered = [Kind::Gnss, Kind::GnssVel, Kind::Baro, Kind::Odometry].map(take);
     let [gnss, vel, baro, odometry] = gathered;
     let topic = |k: Kind| chosen[k.index()].clone().unwrap_or_default();
@@ -409,8 +477,64 @@ pub fn plan(path: &Path, options: &BagReadOptions) -> Result<BagPlan, BagError> 
         clock,
         imu_noise,
         aids,
+        mounting,
+        c_vs,
         options: options.clone(),
     })
+}
+
+/// The IMU's mounting: given by hand (`options.c_vs` when `axes_given`), else from
+/// `/tf_static` (the IMU messages' frame `imu_frame` up to the base frame: the one
+/// named, else the IMU frame's parent), else FLU.
+fn mounting(
+    path: &Path,
+    imu_topic: &str,
+    imu_frame: Option<&str>,
+    tree: &TfTree,
+    options: &BagReadOptions,
+) -> Result<(Mounting, Matrix3<f64>), BagError> {
+    let imu_frame = imu_frame.map(frame_name).filter(|f| !f.is_empty());
+    let parent = imu_frame.and_then(|f| tree.parent(f)).map(str::to_owned);
+    if options.axes_given {
+        if options.base_frame.is_some() {
+            return Err(BagError::file(
+                path,
+                "--base-frame takes the IMU's mounting from /tf_static, --imu-axes and \
+                 --imu-rotation give it by hand: give one",
+            ));
+        }
+        return Ok((Mounting::Given { tf_ignored: parent }, options.c_vs));
+    }
+    let base = match (&options.base_frame, &parent) {
+        (Some(b), _) => frame_name(b).to_owned(),
+        (None, Some(p)) => p.clone(),
+        (None, None) => {
+            let imu_frame = imu_frame.map(str::to_owned);
+            return Ok((Mounting::Flu { imu_frame }, options.c_vs));
+        }
+    };
+    let Some(imu_frame) = imu_frame else {
+        return Err(BagError::topic(
+            path,
+            imu_topic,
+            1,
+            Some("header.frame_id"),
+            format!("empty: --base-frame {base} needs the IMU's frame to find it in /tf_static"),
+        ));
+    };
+    let c_base_imu = tree.rotation(imu_frame, &base).map_err(|e| {
+        let topic = if tree.is_empty() {
+            "the bag has no /tf_static transform".to_owned()
+        } else {
+            e
+        };
+        BagError::file(path, format!("--base-frame {base}: {topic}"))
+    })?;
+    let mounting = Mounting::Tf {
+        imu_frame: imu_frame.to_owned(),
+        base_frame: base,
+    };
+    Ok((mounting, flu_to_frd() * c_base_imu))
 }
 
 /// The run's time of a header: its stamp on the clock plus the offset.
@@ -719,7 +843,7 @@ impl BagPlan {
             stream: BagStream::open(&self.path)?,
             path: self.path.clone(),
             topic: self.topic(Kind::Imu).unwrap_or_default().to_owned(),
-            c_vs: self.options.c_vs,
+            c_vs: self.c_vs,
             times: Times {
                 clock: self.clock,
                 offset: self.options.time_offset,
@@ -785,7 +909,8 @@ impl BagImu {
                     None if m.topic.name != *topic => return Ok(None),
                     _ => *place = Some(m.topic_index),
                 }
-                let imu = ImuMotion::decode(m.data)
+                let enc = check_encoding(path, m.topic)?;
+                let imu = ImuMotion::decode_in(enc, m.data)
                     .map_err(|e| BagError::decode(path, topic, m.index, e))?;
                 let (sec, nanosec) = imu.stamp;
                 let t = times.clock.seconds(sec, nanosec) + times.offset;

@@ -12,6 +12,10 @@ pub mod info;
 pub mod input;
 pub mod messages;
 pub mod output;
+pub mod ros1;
+pub mod ros1_msg;
+pub mod tf;
+pub mod wire;
 
 use std::fmt;
 use std::path::{Path, PathBuf};

@@ -98,7 +98,7 @@ pub struct NavArgs {
     /// GNSS aiding (with --gnss): the error-state Kalman filter.
     #[command(flatten)]
     pub aiding: AidingOptions,
-    /// ROS 2 bags: `--bag` as the input, `--out-bag` for the result.
+    /// ROS bags: `--bag` as the input (ROS 1 or 2), `--out-bag` for the result.
     #[command(flatten)]
     pub bag: BagArgs,
 }
@@ -133,6 +133,7 @@ pub struct NavConfig {
     pub(crate) gnss_vel_topic: Option<String>,
     pub(crate) baro_topic: Option<String>,
     pub(crate) odom_topic: Option<String>,
+    pub(crate) base_frame: Option<String>,
     pub(crate) out_bag: Option<PathBuf>,
     pub(crate) leap_seconds: Option<i64>,
     /// The IMU input keys, read apart ([`ImuInputOptions::split_config`]).
@@ -203,6 +204,7 @@ impl NavConfig {
             gnss_vel_topic: self.gnss_vel_topic.clone(),
             baro_topic: self.baro_topic.clone(),
             odom_topic: self.odom_topic.clone(),
+            base_frame: self.base_frame.clone(),
             out_bag: self.out_bag.clone(),
             leap_seconds: self.leap_seconds,
         }
