@@ -147,6 +147,8 @@ fn integration(
         init_att_std: positive(&key("initattstd"), &y.initattstd)?.map(f64::to_radians),
         init_sensor_std: Some(sensor_std),
         baro: None,
+        gnss_time_offset: 0.0,
+        calibration: Default::default(),
     })
 }
 
@@ -195,6 +197,7 @@ pub fn load(path: &Path, opts: &KfGinsOptions) -> Result<KfGinsRun> {
     };
     let aiding = Aiding {
         raw: None,
+        gnss_time_shift: 0.0,
         fixes: fixes.closed(),
         filter: FilterConfig::new(integration(
             &y,

@@ -268,6 +268,18 @@ pub const LEVER_ARM: Domain = Domain {
     why: "longer than any vehicle",
 };
 
+/// A GNSS time offset from the IMU's clock [s] (or its prior standard deviation):
+/// receivers stamp within a second or two of the IMU on a shared clock; a minute off is
+/// another time scale (GPS against UTC is 18 s, a time zone 3600 s), not an offset.
+pub const GNSS_TIME_OFFSET: Domain = Domain {
+    quantity: "GNSS time offset",
+    min: -60.0,
+    max: 60.0,
+    unit: "s",
+    scale: 1.0,
+    why: "a minute off is another time scale, not an offset",
+};
+
 /// Longitude [rad] after [`wrap_longitude`]: (-180, 180] deg.
 pub const LONGITUDE_WRAPPED: Domain = Domain {
     min: -180.0 * DEG,

@@ -199,6 +199,13 @@ fn print_aided(
             sy.to_degrees()
         );
     }
+    for line in schuler_run::aided::calibration::summary_lines(
+        &summary.nav.calibration,
+        &aiding.filter.integration.lever_arm,
+        aiding.gnss_time_shift,
+    ) {
+        println!("{line}");
+    }
     if let Some(test) = &aiding.outage_test {
         schuler_run::aided::report_outage_test(
             &settings.out.join("nav.txt"),

@@ -272,6 +272,7 @@ mod tests {
             report: ReportSettings::default(),
             vehicle: Default::default(),
             raw: None,
+            gnss_time_shift: 0.0,
         }
     }
 

@@ -4,6 +4,7 @@
 //! aids. [`report`] writes the consistency report, [`record`] `innovations.csv`,
 //! [`vehicle`] resolves the vehicle aids.
 
+pub mod calibration;
 pub mod feed;
 pub mod fixes;
 pub mod raw_gnss;
@@ -91,6 +92,9 @@ pub struct Aiding {
     pub vehicle: VehicleReadings,
     /// Raw GNSS for tight coupling (`--gnss-obs`).
     pub raw: Option<raw_gnss::RawGnss>,
+    /// The time offset added to the GNSS times as they were read [s]
+    /// (`--gnss-time-offset`).
+    pub gnss_time_shift: f64,
 }
 
 /// Aiding readings held in memory, in place of the files of `--gnss`, `--baro` and the
@@ -189,6 +193,22 @@ pub struct AidingOptions {
         allow_hyphen_values = true
     )]
     pub lever_arm: Option<Triple>,
+    /// Estimate the antenna lever arm as filter states, from --lever-arm (or zero),
+    /// prior standard deviation per axis (e.g. `0.5 m`; the flag alone: 1 m). The run
+    /// says which axes the motion observed and prints the flags to use next time.
+    #[arg(long, value_name = "LENGTH", num_args = 0..=1, default_missing_value = "1 m")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
+    pub estimate_lever_arm: Option<String>,
+    /// Estimate the time offset of the GNSS stamps from the IMU's clock (GNSS time +
+    /// offset = IMU time) as a filter state, from --gnss-time-offset (or zero), prior
+    /// standard deviation (e.g. `2 s`; the flag alone: 0.5 s).
+    #[arg(long, value_name = "TIME", num_args = 0..=1, default_missing_value = "0.5 s")]
+    #[serde(default, deserialize_with = "crate::flat_options::text_or_number")]
+    pub estimate_gnss_time_offset: Option<String>,
+    /// Random-walk density of the estimated time offset [s/sqrt(s)], for a drifting
+    /// clock (default 0: a constant offset).
+    #[arg(long, value_name = "DENSITY")]
+    pub gnss_time_offset_walk: Option<f64>,
     /// Innovation gate: significance level of the chi-square test (default 1e-4; 0
     /// turns the gate off).
     #[arg(long, allow_hyphen_values = true, value_name = "ALPHA")]
@@ -414,6 +434,9 @@ impl AidingOptions {
             error_model,
             gnss_vel_std,
             lever_arm,
+            estimate_lever_arm,
+            estimate_gnss_time_offset,
+            gnss_time_offset_walk,
             gate,
             arw,
             vrw,
@@ -586,6 +609,7 @@ impl AidingOptions {
             report: self.report()?,
             fixes,
             raw,
+            gnss_time_shift: self.gnss_time_offset()?.unwrap_or(0.0),
         }))
     }
 
@@ -955,6 +979,9 @@ impl AidingOptions {
             init_att_std: att.map(f64::to_radians),
             init_sensor_std: None,
             baro: None,
+            // --gnss-time-offset is added to the GNSS times as they are read.
+            gnss_time_offset: 0.0,
+            calibration: calibration::calibration(self)?,
         })
     }
 

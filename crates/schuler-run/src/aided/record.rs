@@ -218,49 +218,98 @@ fn opt_out(r: &[f64]) -> Option<f64> {
 }
 
 impl Record for ReportSample {
-    /// `t`, the 17 sensor estimates, the 12 sensor standard deviations, the barometer
-    /// bias's (flag, value), whether there is a NEES, then each NEES's (flag, value).
-    const WIDTH: usize = 1 + 17 + 12 + 2 + 1 + 6;
+    /// `t`; the 21 sensor estimates (gyro and accelerometer biases and scale
+    /// factors, barometer bias, odometer scale factor, mounting, lever-arm and time
+    /// offset corrections); the 12 sensor standard deviations; the barometer bias's
+    /// (flag, value); the lever arm's (flag, value ×3, std ×3, prior std, std from
+    /// the motion ×3); the time offset's (flag, value, std, prior std, std from the
+    /// motion); whether there is a NEES, then each NEES's (flag, value).
+    const WIDTH: usize = 1 + 21 + 12 + 2 + 11 + 5 + 1 + 6;
 
     fn encode(&self, out: &mut [f64]) {
         let e = &self.estimates;
-        out[0] = self.t;
-        let blocks = [e.gyro_bias, e.accel_bias, e.gyro_scale, e.accel_scale];
-        for (k, v) in blocks.iter().chain(&self.sensor_std).enumerate() {
-            let o = if k < 4 { 1 + 3 * k } else { 18 + 3 * (k - 4) };
-            out[o..o + 3].copy_from_slice(v.as_slice());
+        let mut w = Cursor { out, at: 0 };
+        w.put(&[self.t]);
+        for v in [e.gyro_bias, e.accel_bias, e.gyro_scale, e.accel_scale] {
+            w.put(v.as_slice());
         }
-        out[13..18].copy_from_slice(&[
-            e.baro_bias,
-            e.odometer_scale,
-            e.mounting.x,
-            e.mounting.y,
-            e.mounting.z,
-        ]);
-        out[30..32].copy_from_slice(&opt_in(self.baro_std));
-        out[32] = f64::from(u8::from(self.nees.is_some()));
-        for (k, n) in self.nees.unwrap_or([None; 3]).iter().enumerate() {
-            out[33 + 2 * k..35 + 2 * k].copy_from_slice(&opt_in(*n));
+        w.put(&[e.baro_bias, e.odometer_scale]);
+        w.put(e.mounting.as_slice());
+        w.put(e.lever_arm.as_slice());
+        w.put(&[e.gnss_time_offset]);
+        for v in &self.sensor_std {
+            w.put(v.as_slice());
         }
+        w.put(&opt_in(self.baro_std));
+        match &self.calibration.lever_arm {
+            Some(l) => {
+                w.put(&[1.0]);
+                w.put(l.value.as_slice());
+                w.put(l.std.as_slice());
+                w.put(&[l.prior_std]);
+                w.put(l.excited_std.as_slice());
+            }
+            None => w.put(&[0.0; 11]),
+        }
+        match &self.calibration.time_offset {
+            Some(t) => w.put(&[1.0, t.value, t.std, t.prior_std, t.excited_std]),
+            None => w.put(&[0.0; 5]),
+        }
+        w.put(&[f64::from(u8::from(self.nees.is_some()))]);
+        for n in self.nees.unwrap_or([None; 3]) {
+            w.put(&opt_in(n));
+        }
+        debug_assert_eq!(w.at, Self::WIDTH);
     }
 
     fn decode(r: &[f64]) -> Self {
         let v = |o: usize| Vector3::new(r[o], r[o + 1], r[o + 2]);
+        let estimates = schuler::filter::SensorEstimates {
+            gyro_bias: v(1),
+            accel_bias: v(4),
+            gyro_scale: v(7),
+            accel_scale: v(10),
+            baro_bias: r[13],
+            odometer_scale: r[14],
+            mounting: v(15),
+            lever_arm: v(18),
+            gnss_time_offset: r[21],
+        };
+        let calibration = schuler::filter::CalibrationState {
+            lever_arm: (r[36] != 0.0).then(|| schuler::filter::Estimate {
+                value: v(37),
+                std: v(40),
+                prior_std: r[43],
+                excited_std: v(44),
+            }),
+            time_offset: (r[47] != 0.0).then(|| schuler::filter::Estimate {
+                value: r[48],
+                std: r[49],
+                prior_std: r[50],
+                excited_std: r[51],
+            }),
+        };
         ReportSample {
             t: r[0],
-            estimates: schuler::filter::SensorEstimates {
-                gyro_bias: v(1),
-                accel_bias: v(4),
-                gyro_scale: v(7),
-                accel_scale: v(10),
-                baro_bias: r[13],
-                odometer_scale: r[14],
-                mounting: v(15),
-            },
-            sensor_std: [v(18), v(21), v(24), v(27)],
-            baro_std: opt_out(&r[30..32]),
-            nees: (r[32] != 0.0).then(|| std::array::from_fn(|k| opt_out(&r[33 + 2 * k..]))),
+            estimates,
+            sensor_std: [v(22), v(25), v(28), v(31)],
+            baro_std: opt_out(&r[34..36]),
+            calibration,
+            nees: (r[52] != 0.0).then(|| std::array::from_fn(|k| opt_out(&r[53 + 2 * k..]))),
         }
+    }
+}
+
+/// Writes values one after the other into a record.
+struct Cursor<'a> {
+    out: &'a mut [f64],
+    at: usize,
+}
+
+impl Cursor<'_> {
+    fn put(&mut self, v: &[f64]) {
+        self.out[self.at..self.at + v.len()].copy_from_slice(v);
+        self.at += v.len();
     }
 }
 
@@ -268,6 +317,63 @@ impl Record for ReportSample {
 mod tests {
     use super::*;
     use nalgebra::DVector;
+
+    /// A sample with every field distinct comes back bit for bit, with and without
+    /// the optional parts.
+    #[test]
+    fn report_samples_round_trip() {
+        use schuler::filter::{CalibrationState, Estimate, SensorEstimates};
+        let mut k = 0.0;
+        let mut next = || {
+            k += 1.0;
+            k * 0.37
+        };
+        let mut v3 = || Vector3::new(next(), next(), next());
+        let estimates = SensorEstimates {
+            gyro_bias: v3(),
+            accel_bias: v3(),
+            gyro_scale: v3(),
+            accel_scale: v3(),
+            mounting: v3(),
+            lever_arm: v3(),
+            baro_bias: 1.5,
+            odometer_scale: -2.5,
+            gnss_time_offset: 0.08,
+        };
+        let full = ReportSample {
+            t: 12.0,
+            estimates,
+            sensor_std: [v3(), v3(), v3(), v3()],
+            baro_std: Some(0.7),
+            calibration: CalibrationState {
+                lever_arm: Some(Estimate {
+                    value: v3(),
+                    std: v3(),
+                    prior_std: 0.9,
+                    excited_std: v3(),
+                }),
+                time_offset: Some(Estimate {
+                    value: 1.3,
+                    std: 0.01,
+                    prior_std: 2.0,
+                    excited_std: 0.5,
+                }),
+            },
+            nees: Some([Some(1.0), None, Some(3.0)]),
+        };
+        let bare = ReportSample {
+            baro_std: None,
+            calibration: CalibrationState::default(),
+            nees: None,
+            ..full
+        };
+        for s in [full, bare] {
+            let mut r = vec![f64::NAN; ReportSample::WIDTH];
+            s.encode(&mut r);
+            assert!(r.iter().all(|x| x.is_finite()), "every slot written");
+            assert_eq!(ReportSample::decode(&r), s);
+        }
+    }
 
     #[test]
     fn rows_are_padded_and_too_many_components_is_an_error() {

@@ -124,6 +124,7 @@ pub fn fine_align<E: EarthModel>(
         baro_bias_walk: 0.0,
         odometer_scale_walk: 0.0,
         clock: Default::default(),
+        time_offset_walk: 0.0,
     };
     let r_ref = layout.attitude_ref.unwrap_or(15);
     let t0 = samples.first().map_or(0.0, |s| s.t - s.dt);

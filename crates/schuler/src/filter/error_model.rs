@@ -6,9 +6,9 @@
 //!   `G = (g/r) diag(−1, −1, 2)` (gravity gradient, down positive)
 //! - `ψ̇ = −(ω_ie + ρ)×ψ − Ĉ_cb (δb_g + diag(ω^b) δs_g)`
 //! - residual biases: random walks or Gauss–Markov, `ḃ = −b/τ + w` ([`super::noise`]);
-//!   scale factors, the baro bias, the odometer scale factor and
-//!   the reference attitude: constants (the baro bias and the odometer scale factor
-//!   with an optional walk);
+//!   scale factors, the baro bias, the odometer scale factor, the reference attitude
+//!   and the calibrations ([`super::calibration`]): constants (the baro bias, the
+//!   odometer scale factor and the GNSS time offset with an optional walk);
 //! - receiver clock (tight coupling): `ḃ_s = d + w_b` for each system's bias and
 //!   `ḋ = w_d`, the two-state clock of Brown & Hwang (2012, §9.3), white `w_b`, `w_d`
 //!   of densities [`ClockNoise`], one `w_b` for every system (one oscillator: the
@@ -56,6 +56,8 @@ pub struct ErrorModel {
     pub odometer_scale_walk: f64,
     /// The receiver clock's noise, with clock states.
     pub clock: ClockNoise,
+    /// GNSS time offset random-walk density [s/sqrt(s)] (with its state).
+    pub time_offset_walk: f64,
 }
 
 /// The receiver clock's white-noise densities: `q_b` [m²/s] drives the biases,
@@ -177,6 +179,9 @@ impl ErrorModel {
         }
         if let Some(o) = l.odometer_scale {
             q[(o, o)] = self.odometer_scale_walk * self.odometer_scale_walk;
+        }
+        if let Some(o) = l.time_offset {
+            q[(o, o)] = self.time_offset_walk * self.time_offset_walk;
         }
         if let (Some(b), Some(d)) = (l.clock, l.clock_drift()) {
             // One oscillator: its noise is the same in every system's bias (the

@@ -17,6 +17,7 @@
 //! a sample away: at 200 Hz, 2.5 ms, or 2.5 mm/s of speed at 1 m/s² — the heading is
 //! carried over the offset with the body rate).
 
+use super::calibration::{self, AntennaMotion, Calibration, CalibrationState, Estimate};
 use super::error_model::ErrorModel;
 use super::gate_book::GateBook;
 use super::interval::Interval;
@@ -112,6 +113,12 @@ pub struct IntegrationConfig {
     /// Initial standard deviations of gyro bias, accelerometer bias, gyro and
     /// accelerometer scale factors, when they differ from the noise model's.
     pub init_sensor_std: Option<[Vector3<f64>; 4]>,
+    /// GNSS time offset `τ` [s]: a GNSS measurement stamped `t` describes the IMU's
+    /// instant `t + τ` ([`super::calibration`]).
+    pub gnss_time_offset: f64,
+    /// The lever arm and time offset as filter states, from `lever_arm` and
+    /// `gnss_time_offset`.
+    pub calibration: Calibration,
 }
 
 impl IntegrationConfig {
@@ -132,7 +139,17 @@ impl IntegrationConfig {
             init_att_std: Vector3::new(0.1, 0.1, 0.5).map(f64::to_radians),
             baro: None,
             init_sensor_std: None,
+            gnss_time_offset: 0.0,
+            calibration: Calibration::default(),
         }
+    }
+
+    /// How far ahead of the IMU [s] a GNSS measurement may be needed: a stamp `t`
+    /// is applied at `t + τ`, earlier than `t` for a negative offset, which a prior of
+    /// `σ` may reach to 3σ (a session holds its samples back this much longer).
+    pub fn gnss_lead(&self) -> f64 {
+        let spread = 3.0 * self.calibration.time_offset_std.unwrap_or(0.0);
+        (spread - self.gnss_time_offset).max(0.0)
     }
 }
 
@@ -213,6 +230,10 @@ pub struct SensorEstimates {
     /// (rotation vector in the vehicle frame: 0, pitch, yaw) [rad]
     /// ([`VehicleMount::corrected`]).
     pub mounting: Vector3<f64>,
+    /// Correction to the configured GNSS lever arm [m] ([`super::calibration`]).
+    pub lever_arm: Vector3<f64>,
+    /// Correction to the configured GNSS time offset [s].
+    pub gnss_time_offset: f64,
 }
 
 impl SensorEstimates {
@@ -285,6 +306,14 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     interval: Interval,
     estimates: SensorEstimates,
     w_ib_b: Vector3<f64>,
+    /// The last sample's specific force (compensated) [m/s²], and the longest sample
+    /// interval so far [s].
+    f_ib_b: Vector3<f64>,
+    f_dt: f64,
+    /// The time the mechanization started [s].
+    t_start: f64,
+    /// What the motion showed of the calibrations so far.
+    excitation: calibration::Excitation,
     /// The measurements tested, refused and skipped, the counts and gate resets.
     pub book: GateBook,
     /// The record for the smoother, when smoothing.
@@ -315,6 +344,12 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if cfg.baro.is_some() {
             layout = layout.with_baro_bias();
         }
+        if cfg.calibration.lever_arm_std.is_some() {
+            layout = layout.with_lever_arm();
+        }
+        if cfg.calibration.time_offset_std.is_some() {
+            layout = layout.with_time_offset();
+        }
         let (baro_std, baro_walk) = cfg.baro.unwrap_or((0.0, 0.0));
         let model = ErrorModel {
             layout,
@@ -322,6 +357,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             baro_bias_walk: baro_walk,
             odometer_scale_walk: 0.0,
             clock: Default::default(),
+            time_offset_walk: cfg.calibration.time_offset_walk,
         };
         let frame = mech.frame();
         let state = mech.state();
@@ -356,7 +392,17 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         ] {
             p.fixed_view_mut::<3, 3>(o, o).copy_from(&rot(&std));
         }
+        if let (Some(o), Some(std)) = (layout.lever_arm, cfg.calibration.lever_arm_std) {
+            for i in 0..3 {
+                p[(o + i, o + i)] = std * std;
+            }
+        }
+        if let (Some(o), Some(std)) = (layout.time_offset, cfg.calibration.time_offset_std) {
+            p[(o, o)] = std * std;
+        }
         Self {
+            t_start: state.t,
+            excitation: Default::default(),
             mech,
             earth,
             model,
@@ -365,6 +411,8 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             interval: Interval::default(),
             estimates: SensorEstimates::default(),
             w_ib_b: Vector3::zeros(),
+            f_ib_b: Vector3::zeros(),
+            f_dt: 0.0,
             book: GateBook::default(),
             smoother: None,
             tight: None,
@@ -509,6 +557,72 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         self.estimates
     }
 
+    /// The GNSS antenna's lever arm in use: the configured one plus the estimate [m].
+    pub fn lever_arm(&self) -> Vector3<f64> {
+        self.cfg.lever_arm + self.estimates.lever_arm
+    }
+
+    /// The GNSS time offset in use: the configured one plus the estimate [s].
+    pub fn gnss_time_offset(&self) -> f64 {
+        self.cfg.gnss_time_offset + self.estimates.gnss_time_offset
+    }
+
+    /// The calibration estimates now, with their standard deviations.
+    pub fn calibration(&self) -> CalibrationState {
+        let p = &self.kf.p;
+        let sd = |i: usize| p[(i, i)].max(0.0).sqrt();
+        let c = &self.cfg.calibration;
+        let l = &self.model.layout;
+        let seen = |i: usize| self.excitation.std(i);
+        CalibrationState {
+            lever_arm: l.lever_arm.zip(c.lever_arm_std).map(|(o, prior)| Estimate {
+                value: self.lever_arm(),
+                std: Vector3::new(sd(o), sd(o + 1), sd(o + 2)),
+                prior_std: prior,
+                excited_std: Vector3::new(seen(0), seen(1), seen(2)),
+            }),
+            time_offset: l
+                .time_offset
+                .zip(c.time_offset_std)
+                .map(|(o, prior)| Estimate {
+                    value: self.gnss_time_offset(),
+                    std: sd(o),
+                    prior_std: prior,
+                    excited_std: seen(3),
+                }),
+        }
+    }
+
+    /// The IMU time at which a GNSS measurement stamped `t` applies: `t + τ̂`, or now
+    /// if that has passed after the start (the estimate moved back past it; the
+    /// prediction is carried back, [`super::calibration`]).
+    pub fn gnss_instant(&self, t: f64) -> f64 {
+        let at = t + self.gnss_time_offset();
+        if at >= self.t_start {
+            at.max(self.mech.state().t)
+        } else {
+            at
+        }
+    }
+
+    /// The antenna's motion now and the gap to the instant of a GNSS measurement
+    /// stamped `t`.
+    fn antenna_motion(&self, t: f64) -> (AntennaMotion, f64) {
+        let frame = self.mech.frame();
+        let gap = t + self.gnss_time_offset() - frame.t;
+        // White accelerometer noise over the last sample: VRW² / dt.
+        let f_var = self.cfg.noise.vrw.norm_squared() / 3.0 / self.f_dt.max(1e-6);
+        let k = AntennaMotion::of(
+            &frame,
+            &self.w_ib_b,
+            &self.f_ib_b,
+            f_var,
+            &self.lever_arm(),
+            &self.kf.p,
+        );
+        (k, gap)
+    }
+
     /// The state layout.
     pub fn layout(&self) -> Layout {
         self.model.layout
@@ -549,6 +663,9 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         self.interval.add(&s, &q_bc);
         if s.dt > 0.0 {
             self.w_ib_b = s.dtheta / s.dt;
+            self.f_ib_b = s.dvel / s.dt;
+            // The IMU's period: split samples (at a fix) are shorter, not noisier.
+            self.f_dt = self.f_dt.max(s.dt);
         }
         if self.interval.t >= self.cfg.propagation_interval {
             self.propagate();
@@ -615,6 +732,10 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             interval: Interval::default(),
             estimates: self.estimates,
             w_ib_b: self.w_ib_b,
+            f_ib_b: self.f_ib_b,
+            f_dt: self.f_dt,
+            t_start: self.t_start,
+            excitation: self.excitation,
             book: self.book,
             smoother: self.smoother,
             tight: self.tight,
@@ -631,32 +752,46 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         self.book.skip(t, kind, reason);
     }
 
-    /// Apply a GNSS fix now (position, then velocity if present).
+    /// Apply a GNSS fix now (position, then velocity if present), of the instant
+    /// [`Integrator::gnss_instant`] gives its time.
     pub fn update_gnss(&mut self, fix: &GnssFix) {
         self.propagate();
-        let lever = self.cfg.lever_arm;
         let layout = self.model.layout;
-        let m = measurement::gnss_position(
+        let mut m = measurement::gnss_position(
             &self.earth,
             &layout,
             &self.mech.frame(),
             &fix.pos,
             &fix.pos_std,
-            &lever,
+            &self.lever_arm(),
         );
+        self.calibrate(&mut m, fix.t);
         self.apply(fix.t, m);
         if let Some((v, std)) = fix.vel {
-            let m = measurement::gnss_velocity(
+            let mut m = measurement::gnss_velocity(
                 &layout,
                 &self.mech.frame(),
                 &fix.pos,
                 &v,
                 &std,
-                &lever,
+                &self.lever_arm(),
                 &self.w_ib_b,
             );
+            self.calibrate(&mut m, fix.t);
             self.apply(fix.t, m);
         }
+    }
+
+    /// The calibration columns of GNSS measurement `m` stamped `t`, and its
+    /// prediction carried to its instant ([`super::calibration`]); nothing to do
+    /// without calibration and a time offset of zero.
+    fn calibrate(&mut self, m: &mut Measurement, t: f64) {
+        let l = self.model.layout;
+        if l.lever_arm.is_none() && l.time_offset.is_none() && self.gnss_time_offset() == 0.0 {
+            return;
+        }
+        let (k, gap) = self.antenna_motion(t);
+        calibration::add_columns(m, &l, &k, gap, &mut self.excitation);
     }
 
     /// Gate a measurement, record it in [`Integrator::book`] and, if accepted,
@@ -699,6 +834,12 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         if let Some(o) = l.mounting {
             self.estimates.mounting += Vector3::new(0.0, dx[o], dx[o + 1]);
         }
+        if let Some(o) = l.lever_arm {
+            self.estimates.lever_arm += v3(o);
+        }
+        if let Some(o) = l.time_offset {
+            self.estimates.gnss_time_offset += dx[o];
+        }
         if let Some(t) = self.tight.as_mut() {
             t.clocks.feed_back(&l, dx);
         }
@@ -721,7 +862,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         let (Some(b0), Some(d)) = (layout.clock, layout.clock_drift()) else {
             return 0;
         };
-        let lever = self.cfg.lever_arm;
+        let lever = self.lever_arm();
         tight.counts.epochs += 1;
         tight.clocks.advance(e.t);
         let antenna = ranging::Antenna::of(&self.mech.frame(), &lever, &self.w_ib_b);
@@ -745,7 +886,8 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             };
             let pr = s.measurement.pseudorange.unwrap_or(f64::NAN);
             let z = p.pseudorange + bias - pr;
-            let m = ranging::pseudorange(&layout, &a, &p.u, z, p.pseudorange_var, b0 + k);
+            let mut m = ranging::pseudorange(&layout, &a, &p.u, z, p.pseudorange_var, b0 + k);
+            self.calibrate(&mut m, e.t);
             tested += 1;
             accepted += usize::from(self.apply_range(e.t, m, s.sat, gate, reset, tight));
             let (Some(rate), Some(drift), true) = (
@@ -761,7 +903,8 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             };
             let Some(predicted) = p.rate else { continue };
             let z = predicted + drift - rate;
-            let m = ranging::range_rate(&layout, &a, &lever, &p.u, p.k, z, p.rate_var, d);
+            let mut m = ranging::range_rate(&layout, &a, &lever, &p.u, p.k, z, p.rate_var, d);
+            self.calibrate(&mut m, e.t);
             tested += 1;
             accepted += usize::from(self.apply_range(e.t, m, s.sat, gate, reset, tight));
         }
@@ -955,6 +1098,11 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 pub trait FixConsumer<T = GnssFix> {
     /// The mechanization's time [s].
     fn now(&self) -> f64;
+    /// The IMU time at which a fix stamped `t` applies (`t` itself unless the
+    /// filter has a GNSS time offset, [`super::calibration`]).
+    fn instant(&self, t: f64) -> f64 {
+        t
+    }
     /// Mechanize one sample with no fix inside it.
     fn step_sample(&mut self, s: &ImuSample);
     /// Apply a fix now.
@@ -966,6 +1114,9 @@ pub trait FixConsumer<T = GnssFix> {
 impl<M: ErrorFrame, E: EarthModel> FixConsumer for Integrator<M, E> {
     fn now(&self) -> f64 {
         self.mech.state().t
+    }
+    fn instant(&self, t: f64) -> f64 {
+        self.gnss_instant(t)
     }
     fn step_sample(&mut self, s: &ImuSample) {
         self.step(s);
@@ -981,6 +1132,9 @@ impl<M: ErrorFrame, E: EarthModel> FixConsumer for Integrator<M, E> {
 impl<M: ErrorFrame, E: EarthModel> FixConsumer<GnssUpdate> for Integrator<M, E> {
     fn now(&self) -> f64 {
         self.mech.state().t
+    }
+    fn instant(&self, t: f64) -> f64 {
+        self.gnss_instant(t)
     }
     fn step_sample(&mut self, s: &ImuSample) {
         self.step(s);
@@ -1002,8 +1156,9 @@ impl<M: ErrorFrame, E: EarthModel> FixConsumer<GnssUpdate> for Integrator<M, E> 
 }
 
 /// Mechanize a sample of `c` during which GNSS fixes may fall: fixes from `fixes`
-/// with times up to the sample's end are applied at their own times (the sample is
-/// split there, [`split`]); fixes before the mechanization's time are skipped.
+/// whose instants ([`FixConsumer::instant`]) fall up to the sample's end are applied
+/// there (the sample is split there, [`split`]); fixes before the mechanization's
+/// time are skipped.
 pub fn step_with_fixes<T, C: FixConsumer<T>, F: FixSource<T>>(
     c: &mut C,
     raw: &ImuSample,
@@ -1011,7 +1166,8 @@ pub fn step_with_fixes<T, C: FixConsumer<T>, F: FixSource<T>>(
 ) {
     let tol = 1e-3 * raw.dt.max(1e-9);
     let mut rest = Some(*raw);
-    while let Some(ft) = fixes.next_time() {
+    while let Some(stamp) = fixes.next_time() {
+        let ft = c.instant(stamp);
         let now = c.now();
         if ft < now - tol {
             if let Some(f) = fixes.pop_fix() {

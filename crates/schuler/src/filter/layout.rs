@@ -29,6 +29,11 @@ pub struct Layout {
     pub clock: Option<usize>,
     /// How many clock biases (systems) [`Layout::clock`] holds.
     pub clock_systems: usize,
+    /// The GNSS antenna's lever arm (3, body axes), if calibrated
+    /// ([`super::calibration`]).
+    pub lever_arm: Option<usize>,
+    /// The GNSS-to-IMU time offset (1), if calibrated.
+    pub time_offset: Option<usize>,
 }
 
 impl Layout {
@@ -55,6 +60,8 @@ impl Layout {
             mounting: None,
             clock: None,
             clock_systems: 0,
+            lever_arm: None,
+            time_offset: None,
         }
     }
 
@@ -102,6 +109,20 @@ impl Layout {
         self
     }
 
+    /// Add the GNSS antenna's lever arm.
+    pub fn with_lever_arm(mut self) -> Self {
+        self.lever_arm = Some(self.n);
+        self.n += 3;
+        self
+    }
+
+    /// Add the GNSS-to-IMU time offset.
+    pub fn with_time_offset(mut self) -> Self {
+        self.time_offset = Some(self.n);
+        self.n += 1;
+        self
+    }
+
     /// The offset of the clock drift, with a clock.
     pub fn clock_drift(&self) -> Option<usize> {
         self.clock.map(|o| o + self.clock_systems)
@@ -130,9 +151,11 @@ impl Layout {
         block(self.gyro_scale, "sg");
         block(self.accel_scale, "sa");
         block(self.attitude_ref, "psi_ref");
+        block(self.lever_arm, "lever");
         for (at, name) in [
             (self.baro_bias, "baro_bias"),
             (self.odometer_scale, "odometer_scale"),
+            (self.time_offset, "gnss_time_offset"),
         ] {
             if let Some(o) = at {
                 names[o] = name.into();
@@ -178,6 +201,12 @@ mod tests {
         // Another order of the builders: the names follow the offsets.
         let l = Layout::core().with_odometer_scale().with_baro_bias();
         assert_eq!(l.names()[15..], ["odometer_scale", "baro_bias"]);
+        let l = Layout::core().with_time_offset().with_lever_arm();
+        assert_eq!((l.n, l.time_offset, l.lever_arm), (19, Some(15), Some(16)));
+        assert_eq!(
+            l.names()[15..],
+            ["gnss_time_offset", "lever_x", "lever_y", "lever_z"]
+        );
         let l = Layout::core().with_clock(2);
         assert_eq!((l.n, l.clock, l.clock_drift()), (18, Some(15), Some(17)));
         assert_eq!(

@@ -7,6 +7,7 @@
 //!   discrete process noise (non-singular at the poles, see [`crate::nav::frame`]);
 //! - [`interval`]: the sums over one propagation interval;
 //! - [`measurement`]: GNSS position and velocity with lever arm, barometric height;
+//! - [`calibration`]: the lever arm and the GNSS time offset as states;
 //! - [`vehicle`]: zero velocity and angular rate at rest, the non-holonomic
 //!   constraint, odometer speed, dual-antenna heading;
 //! - [`integration`]: the INS/GNSS filter loop;
@@ -17,6 +18,7 @@
 //! - [`kalman`]: covariance propagation, Joseph-form update and the chi-square
 //!   innovation gate.
 
+pub mod calibration;
 pub mod error_model;
 pub mod gate_book;
 pub mod integration;
@@ -31,6 +33,7 @@ pub mod smoother;
 pub mod spill;
 pub mod vehicle;
 
+pub use calibration::{Calibration, CalibrationState, Estimate};
 pub use error_model::{ClockNoise, ErrorModel, IntervalMeans};
 pub use integration::{FixSource, GnssFix, IntegrationConfig, Integrator, SensorEstimates};
 pub use kalman::{Gate, Kalman, Rejection, Update};

@@ -81,20 +81,22 @@ impl Epoch {
 }
 
 /// The values of `e`'s fields as bits (so that `-0.0` and `0.0` differ).
-fn bits(e: &SensorEstimates) -> [u64; 17] {
-    let mut b = [0u64; 17];
+fn bits(e: &SensorEstimates) -> [u64; 21] {
+    let mut b = [0u64; 21];
     let v = [
         &e.gyro_bias,
         &e.accel_bias,
         &e.gyro_scale,
         &e.accel_scale,
         &e.mounting,
+        &e.lever_arm,
     ];
     for (i, x) in v.iter().flat_map(|v| v.iter()).enumerate() {
         b[i] = x.to_bits();
     }
-    b[15] = e.baro_bias.to_bits();
-    b[16] = e.odometer_scale.to_bits();
+    b[18] = e.baro_bias.to_bits();
+    b[19] = e.odometer_scale.to_bits();
+    b[20] = e.gnss_time_offset.to_bits();
     b
 }
 
@@ -442,6 +444,12 @@ impl SmoothedTrajectory {
         }
         if let Some(o) = layout.mounting {
             est.mounting += Vector3::new(0.0, err[o], err[o + 1]);
+        }
+        if let Some(o) = layout.lever_arm {
+            est.lever_arm += v3(o);
+        }
+        if let Some(o) = layout.time_offset {
+            est.gnss_time_offset += err[o];
         }
         est
     }

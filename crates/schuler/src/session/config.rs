@@ -472,6 +472,9 @@ impl SessionConfig {
         if f.smooth {
             return refuse("smoother");
         }
+        if f.integration.calibration.any() || f.integration.gnss_time_offset != 0.0 {
+            return refuse("lever-arm or time-offset calibration");
+        }
         if f.vehicle.any() {
             return refuse("vehicle aids (zero velocity, non-holonomic, odometer, heading)");
         }
@@ -540,6 +543,32 @@ impl FilterConfig {
             non_negative("filter.integration.baro", walk)?;
             positive("filter.baro_std", self.baro_std)?;
         }
+        within(
+            "filter.integration.gnss_time_offset",
+            &domain::GNSS_TIME_OFFSET,
+            c.gnss_time_offset,
+        )?;
+        let cal = &c.calibration;
+        if let Some(std) = cal.lever_arm_std {
+            positive("filter.integration.calibration.lever_arm_std", std)?;
+            within(
+                "filter.integration.calibration.lever_arm_std",
+                &domain::LEVER_ARM,
+                std,
+            )?;
+        }
+        if let Some(std) = cal.time_offset_std {
+            positive("filter.integration.calibration.time_offset_std", std)?;
+            within(
+                "filter.integration.calibration.time_offset_std",
+                &domain::GNSS_TIME_OFFSET,
+                std,
+            )?;
+        }
+        non_negative(
+            "filter.integration.calibration.time_offset_walk",
+            cal.time_offset_walk,
+        )?;
         self.vehicle.validate()
     }
 }

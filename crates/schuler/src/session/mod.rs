@@ -162,6 +162,8 @@ pub struct Summary {
     /// errors removed) and the standard deviations of its pitch and yaw [rad], when
     /// the mounting was estimated.
     pub mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
+    /// The lever arm and GNSS time offset at the end, when calibrated.
+    pub calibration: crate::filter::CalibrationState,
     /// What the baro loop's fault detector did, when it ran.
     pub baro_loop: Option<DetectorCounts>,
 }
@@ -379,7 +381,14 @@ impl<E: EarthModel> Session<E> {
             return Err(SessionError::ImuTimeNotIncreasing { t: s.t, previous });
         }
         self.run.last_pushed = Some(s.t);
-        let window = self.run.cfg.reorder_window;
+        // A negative GNSS time offset applies fixes before their stamps: the samples
+        // wait that much longer, so that fixes pushed in stamp order are there.
+        let lead = self
+            .run
+            .cfg
+            .filter
+            .map_or(0.0, |f| f.integration.gnss_lead());
+        let window = self.run.cfg.reorder_window + lead;
         if window == 0.0 && self.run.imu.is_empty() {
             self.integrate(&s);
         } else {
@@ -564,6 +573,7 @@ impl<E: EarthModel> Session<E> {
                 states: end.states,
                 estimates: end.estimates,
                 mounting: end.mounting,
+                calibration: end.calibration,
                 baro_loop: run.baro_loop.map(|l| l.counts),
             },
             epochs: run.epochs.into(),
@@ -642,6 +652,7 @@ struct FilterEnd {
     states: Option<usize>,
     estimates: Option<crate::filter::SensorEstimates>,
     mounting: Option<(crate::filter::VehicleMount, [f64; 2])>,
+    calibration: crate::filter::CalibrationState,
     smoothed: Option<SmoothedTrajectory>,
 }
 
@@ -672,6 +683,7 @@ fn filter_end<M: ErrorFrame, E: EarthModel>(
         states: Some(i.layout().n),
         estimates: Some(i.estimates()),
         mounting,
+        calibration: i.calibration(),
         smoothed,
     })
 }

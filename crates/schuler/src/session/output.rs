@@ -10,7 +10,7 @@ use crate::filter::integration::{Innovation, Rejected, Skipped};
 use crate::filter::kalman::std3;
 use crate::filter::measurement::Kind;
 use crate::filter::seed18::Seed18;
-use crate::filter::{Integrator, Layout, SensorEstimates};
+use crate::filter::{CalibrationState, Integrator, Layout, SensorEstimates};
 use crate::nav::{ErrorFrame, NavState};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::VecDeque;
@@ -91,6 +91,10 @@ pub(crate) trait FilterView {
     fn view_epoch(&self) -> FilterEpoch;
     /// Standard deviation of the barometer bias, when estimated.
     fn view_baro_std(&self) -> Option<f64>;
+    /// The calibration estimates ([`crate::filter::calibration`]).
+    fn view_calibration(&self) -> CalibrationState {
+        CalibrationState::default()
+    }
 }
 
 impl<M: ErrorFrame, E: EarthModel> FilterView for Integrator<M, E> {
@@ -103,6 +107,9 @@ impl<M: ErrorFrame, E: EarthModel> FilterView for Integrator<M, E> {
     fn view_baro_std(&self) -> Option<f64> {
         let p = self.covariance();
         self.layout().baro_bias.map(|b| p[(b, b)].max(0.0).sqrt())
+    }
+    fn view_calibration(&self) -> CalibrationState {
+        self.calibration()
     }
 }
 
@@ -225,6 +232,8 @@ pub struct Snapshot {
     pub sensor_std: [Vector3<f64>; 4],
     /// Standard deviation of the barometer bias [m], when estimated.
     pub baro_std: Option<f64>,
+    /// The lever arm and time offset, when calibrated.
+    pub calibration: CalibrationState,
     /// NEES of position, velocity and attitude (3 dof each): `None` without a truth
     /// at this time; an entry `None` where the covariance block is not positive
     /// definite.
@@ -304,6 +313,7 @@ impl SnapshotTaker {
             estimates: f.estimates,
             sensor_std: f.sensor_std,
             baro_std: integ.view_baro_std(),
+            calibration: integ.view_calibration(),
             nees,
         });
     }

@@ -57,6 +57,9 @@ pub struct GnssModel {
     pub vel_std: Vector3<f64>,
     /// Antenna lever arm in body axes [m].
     pub lever_arm: Vector3<f64>,
+    /// Time offset `τ` [s]: the fix of the instant `t` is stamped `t − τ`
+    /// (`t_imu = t_gnss + τ`, as [`crate::filter::calibration`] estimates it).
+    pub time_offset: f64,
     /// No fixes inside these intervals.
     pub outages: Vec<Interval>,
     /// Position jumps (NED metres).
@@ -206,7 +209,7 @@ impl GnssSimulator {
         let v_ant = s.v_n + c_bn * w_eb_b.cross(&m.lever_arm);
         let v_n = c_ned_to_ned(&s.pos, &pos) * v_ant + m.vel_std.component_mul(&n_vel);
         Some(GnssFix {
-            t: s.t,
+            t: s.t - m.time_offset,
             pos,
             v_n,
             pos_std: m.pos_std,
@@ -288,6 +291,7 @@ mod tests {
             pos_std: Vector3::zeros(),
             vel_std: Vector3::zeros(),
             lever_arm: Vector3::new(1.0, 0.0, 0.0),
+            time_offset: 0.0,
             outages: vec![],
             outliers: vec![],
         };
@@ -330,6 +334,7 @@ mod tests {
                 pos_std: Vector3::zeros(),
                 vel_std: Vector3::zeros(),
                 lever_arm: lever,
+                time_offset: 0.0,
                 outages: vec![],
                 outliers: vec![],
             };
@@ -378,6 +383,7 @@ mod tests {
             pos_std: Vector3::zeros(),
             vel_std: Vector3::zeros(),
             lever_arm: Vector3::zeros(),
+            time_offset: 0.0,
             outages: vec![Interval {
                 start: 10.0,
                 end: 20.0,

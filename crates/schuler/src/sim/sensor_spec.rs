@@ -393,6 +393,8 @@ pub struct GnssSpec {
     pub velocity_std: Option<[Quantity; 3]>,
     /// Antenna lever arm in body axes.
     pub lever_arm: Option<[Quantity; 3]>,
+    /// Time offset `τ`: the fix of the instant `t` is stamped `t − τ`.
+    pub time_offset: Option<Quantity>,
     /// Outages `[start, end]`.
     #[serde(default)]
     pub outages: Vec<IntervalSpec>,
@@ -484,6 +486,14 @@ impl GnssSpec {
             lever_arm: self.lever_arm.as_ref().map_or_else(zero, |v| {
                 vec3_in(v, "gnss.lever_arm", Dimension::Length, &domain::LEVER_ARM)
             })?,
+            time_offset: match &self.time_offset {
+                None => 0.0,
+                Some(q) => within(
+                    &domain::GNSS_TIME_OFFSET,
+                    "gnss.time_offset",
+                    q.si("gnss.time_offset", Dimension::Time)?,
+                )?,
+            },
             outages: intervals(&self.outages, "gnss.outages")?,
             outliers: self
                 .outliers

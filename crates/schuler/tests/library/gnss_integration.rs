@@ -116,6 +116,7 @@ fn fixes(seed: u64, outliers: &[(f64, Vector3<f64>)]) -> (Vec<GnssFix>, usize) {
         pos_std: Vector3::new(0.02, 0.02, 0.05),
         vel_std: Vector3::new(0.02, 0.02, 0.02),
         lever_arm: Vector3::from(LEVER),
+        time_offset: 0.0,
         outages: OUTAGES
             .iter()
             .map(|&(start, end)| Interval { start, end })

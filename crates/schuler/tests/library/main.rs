@@ -7,6 +7,7 @@
 mod common;
 
 mod alignment;
+mod calibration;
 mod channel_closed_forms;
 mod channel_fundamental;
 mod channel_leveling;

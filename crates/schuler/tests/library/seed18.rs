@@ -127,6 +127,7 @@ impl Case {
             },
             vel_std: Vector3::new(0.05, 0.05, 0.1),
             lever_arm: Vector3::zeros(),
+            time_offset: 0.0,
             outages: if sortie {
                 vec![receivers::Interval {
                     start: SORTIE_OUTAGE.0,

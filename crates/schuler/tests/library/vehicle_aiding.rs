@@ -182,6 +182,7 @@ fn fixes(d: &Data, seed: u64, outages: &[(f64, f64)]) -> Vec<GnssFix> {
         pos_std: Vector3::new(GNSS_POS_STD, GNSS_POS_STD, 2.0 * GNSS_POS_STD),
         vel_std: Vector3::repeat(0.05),
         lever_arm: Vector3::zeros(),
+        time_offset: 0.0,
         outages: outages
             .iter()
             .map(|&(start, end)| Interval { start, end })

@@ -161,5 +161,6 @@ pub fn process_model(layout: Layout, cfg: &IntegrationConfig) -> ErrorModel {
         baro_bias_walk: cfg.baro.map_or(0.0, |(_, walk)| walk),
         odometer_scale_walk: 0.0,
         clock: Default::default(),
+        time_offset_walk: cfg.calibration.time_offset_walk,
     }
 }
