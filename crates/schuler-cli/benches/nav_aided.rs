@@ -16,7 +16,8 @@ use schuler::sim::sensor_spec::{ImuSpec, Preset};
 use schuler_io::formats::ImuReader;
 use schuler_io::output::write_imu_text;
 use schuler_run::aided::{Aiding, OutputNames};
-use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::navigate::{NavSettings, navigate, samples_of};
+use schuler_run::options::EarthChoice;
 use std::path::PathBuf;
 
 mod common;
@@ -108,8 +109,16 @@ fn bench_aided(c: &mut Criterion) {
             b.iter(|| {
                 let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
                 let start = settings.start();
-                navigate(Wgs84, &settings, Some(&aiding), start, &mut reader, |_| {})
-                    .expect("navigate")
+                let mut samples = samples_of(&mut reader);
+                navigate(
+                    EarthChoice::Wgs84,
+                    &settings,
+                    Some(&aiding),
+                    start,
+                    &mut samples,
+                    &mut |_| {},
+                )
+                .expect("navigate")
             })
         });
     }

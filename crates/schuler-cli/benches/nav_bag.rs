@@ -14,7 +14,8 @@ use schuler_io::bag::input::{BagReadOptions, plan};
 use schuler_io::bag::messages::{Header, Imu, NavSatFix, definitions};
 use schuler_io::formats::ImuReader;
 use schuler_run::aided::AidingOptions;
-use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::navigate::{NavSettings, navigate, samples_of};
+use schuler_run::options::EarthChoice;
 use schuler_run::options::GradeChoice;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -157,7 +158,16 @@ impl Runs {
             .expect("aiding");
         let s = &self.settings;
         let mut reader = ImuReader::open(&s.imu, &s.read).expect("open");
-        navigate(Wgs84, s, aiding.as_ref(), s.start(), &mut reader, |_| {}).expect("navigate");
+        let mut samples = samples_of(&mut reader);
+        navigate(
+            EarthChoice::Wgs84,
+            s,
+            aiding.as_ref(),
+            s.start(),
+            &mut samples,
+            &mut |_| {},
+        )
+        .expect("navigate");
     }
 
     fn bag(&self) {
@@ -168,7 +178,16 @@ impl Runs {
             .expect("aiding");
         let samples = p.imu_samples().expect("samples");
         let s = &self.settings;
-        navigate(Wgs84, s, aiding.as_ref(), s.start(), samples, |_| {}).expect("navigate");
+        let mut samples = samples_of(samples);
+        navigate(
+            EarthChoice::Wgs84,
+            s,
+            aiding.as_ref(),
+            s.start(),
+            &mut samples,
+            &mut |_| {},
+        )
+        .expect("navigate");
     }
 }
 

@@ -11,7 +11,7 @@ use schuler::earth::{Geodetic, Wgs84};
 use schuler::sim::analytic::{self, Maneuvering};
 use schuler_io::formats::{ImuReadOptions, ImuReader};
 use schuler_io::output::write_imu_text;
-use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::navigate::{NavSettings, navigate, samples_of};
 use schuler_run::options::EarthChoice;
 use std::path::PathBuf;
 
@@ -55,12 +55,12 @@ fn bench_nav(c: &mut Criterion) {
                     .read_ahead()
                     .expect("helper thread");
                 navigate(
-                    Wgs84,
+                    EarthChoice::Wgs84,
                     &settings,
                     None,
                     settings.start(),
-                    &mut reader,
-                    |_| {},
+                    &mut samples_of(&mut reader),
+                    &mut |_| {},
                 )
                 .expect("navigate")
             })

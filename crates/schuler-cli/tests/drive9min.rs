@@ -2,15 +2,15 @@
 //! drive made by gnss-ins-sim (not by schuler), with KF-GINS's published figures on the
 //! same data (`tests/data/README.md`).
 
+mod common;
 use nalgebra::Vector3;
 use schuler::analysis::errors::{EpochErrors, NavRecord, errors_at};
 use schuler::earth::{Geodetic, Wgs84};
 use schuler::rotation::Euler;
 use schuler::session::{MechanizationChoice, MechanizationConfig};
 use schuler_io::formats::{ImuReadOptions, ImuReader};
-use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::navigate::{NavSettings, navigate, samples_of};
 use schuler_run::options::EarthChoice;
-mod common;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -109,12 +109,12 @@ fn run(dir: &Path, imu: PathBuf) -> Errors {
     };
     let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
     navigate(
-        Wgs84,
+        EarthChoice::Wgs84,
         &settings,
         None,
         settings.start(),
-        &mut reader,
-        |_| {},
+        &mut samples_of(&mut reader),
+        &mut |_| {},
     )
     .expect("navigate");
     errors(&dir.join("out/nav.txt"), &unpack(dir, "truth.nav"))

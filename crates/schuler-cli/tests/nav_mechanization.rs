@@ -12,7 +12,7 @@ use schuler::sim::analytic::{self, Trajectory};
 use schuler::sim::jet::{Jet, JetMat3, JetVec3};
 use schuler_io::formats::{ImuReadOptions, ImuReader};
 use schuler_io::output::{CSV_HEADER_EXTENDED, write_imu_text};
-use schuler_run::navigate::{NavSettings, navigate};
+use schuler_run::navigate::{NavSettings, navigate, samples_of};
 use schuler_run::options::EarthChoice;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -122,12 +122,12 @@ fn run(mechanization: MechanizationConfig, out: &Path) -> Summary {
     };
     let mut reader = ImuReader::open(&settings.imu, &settings.read).expect("open");
     navigate(
-        Wgs84,
+        EarthChoice::Wgs84,
         &settings,
         None,
         settings.start(),
-        &mut reader,
-        |_| {},
+        &mut samples_of(&mut reader),
+        &mut |_| {},
     )
     .expect("navigate")
     .nav

@@ -2,12 +2,13 @@
 //! written, reading the stage's samples, running the library's alignment on the
 //! chosen Earth model, and its report, `align.json` and convergence files.
 
+use crate::earth::AnyEarth;
 use crate::imu_input::ImuInputOptions;
 use crate::options::{EarthChoice, GradeChoice, Triple};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::align::{AlignConfig, AlignError, Alignment, HeadingSource, MotionReport, align};
-use schuler::earth::{Geodetic, Sphere, Wgs84, Wgs84Series};
+use schuler::earth::Geodetic;
 use schuler::filter::ImuNoise;
 use schuler::imu::ImuSample;
 use schuler::rotation::Euler;
@@ -119,11 +120,11 @@ impl AlignOptions {
 /// caller may use to continue). Samples are read lazily and reading stops there.
 pub fn read_stage<I, E>(samples: &mut I, seconds: f64) -> Result<Vec<ImuSample>>
 where
-    I: Iterator<Item = Result<ImuSample, E>>,
-    E: std::error::Error + Send + Sync + 'static,
+    I: Iterator<Item = Result<ImuSample, E>> + ?Sized,
+    anyhow::Error: From<E>,
 {
     let mut out: Vec<ImuSample> = Vec::new();
-    for s in samples.by_ref() {
+    for s in &mut *samples {
         let s = s?;
         let t0 = out.first().map_or(s.t - s.dt, |f| f.t - f.dt);
         let done = s.t > t0 + seconds + 0.5 * s.dt;
@@ -143,17 +144,7 @@ pub fn align_on(
     noise: &ImuNoise,
     cfg: &AlignConfig,
 ) -> Result<Alignment> {
-    let r = match earth {
-        EarthChoice::Wgs84 => align(Wgs84, pos, samples, noise, cfg),
-        EarthChoice::Wgs84Series => align(Wgs84Series, pos, samples, noise, cfg),
-        EarthChoice::Sphere | EarthChoice::SphereFixed => align(
-            Sphere::textbook(earth == EarthChoice::Sphere),
-            pos,
-            samples,
-            noise,
-            cfg,
-        ),
-    };
+    let r = align(AnyEarth::of(earth), pos, samples, noise, cfg);
     r.map_err(|e| match e {
         AlignError::NotEnoughData { .. } => anyhow::anyhow!(
             "{e}: shorten the stages with --coarse and --fine (their sum at most the log's \

@@ -16,12 +16,11 @@
 
 use crate::aided::report::ReportSettings;
 use crate::aided::{Aiding, OutputNames};
-use crate::navigate::{NavSettings, RunSummary, navigate};
+use crate::navigate::{NavSettings, RunSummary, navigate, samples_of};
 use crate::options::{EarthChoice, GravityChoice};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
-use schuler::earth::{Wgs84, Wgs84Series};
 use schuler::filter::integration::SensorEstimates;
 use schuler::filter::{Gate, IntegrationConfig};
 use schuler::rotation::Euler;
@@ -248,18 +247,18 @@ pub fn run_kf_gins(path: &Path, opts: &KfGinsOptions) -> Result<(KfGinsRun, RunS
         estimates: aiding.initial_errors,
         ..settings.start()
     };
-    let summary = match run.gravity {
-        GravityChoice::KfGins => navigate(
-            Wgs84Series,
-            settings,
-            Some(aiding),
-            start,
-            &mut reader,
-            |_| {},
-        )?,
-        GravityChoice::Tr8350 => {
-            navigate(Wgs84, settings, Some(aiding), start, &mut reader, |_| {})?
-        }
+    let earth = match run.gravity {
+        GravityChoice::KfGins => EarthChoice::Wgs84Series,
+        GravityChoice::Tr8350 => EarthChoice::Wgs84,
     };
+    let mut samples = samples_of(&mut reader);
+    let summary = navigate(
+        earth,
+        settings,
+        Some(aiding),
+        start,
+        &mut samples,
+        &mut |_| {},
+    )?;
     Ok((run, summary))
 }

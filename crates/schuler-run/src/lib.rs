@@ -19,6 +19,7 @@ pub mod channel;
 pub mod compare;
 pub mod demo;
 pub mod drive;
+pub mod earth;
 pub mod flat_options;
 pub mod gnss;
 pub mod imu_input;

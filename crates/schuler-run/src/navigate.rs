@@ -8,6 +8,8 @@ use crate::aided::report::{ReportData, RunFacts};
 use crate::aided::spilled::Spilled;
 use crate::aided::{Aiding, OutputNames};
 use crate::drive::{Driven, FilterFiles, Outputs, drive, write_smoothed};
+pub use crate::drive::{Samples, samples_of};
+use crate::earth::AnyEarth;
 use crate::options::EarthChoice;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
@@ -245,21 +247,19 @@ fn finish_aided<E: EarthModel>(
     )
 }
 
-/// Navigate `samples` (the first carries `start`) on `earth` with the settings and,
-/// if given, the aiding; write everything into `settings.out`. On a read error all
-/// that was computed is written before the error is returned.
-pub fn navigate<E: EarthModel, I, Fail>(
-    earth: E,
+/// Navigate `samples` (the first carries `start`) on the Earth model `earth` with the
+/// settings and, if given, the aiding; write everything into `settings.out`. On a
+/// read error all that was computed is written before the error is returned.
+/// `on_sample` is called every 65,536 samples with their count ([`drive`]).
+pub fn navigate(
+    earth: EarthChoice,
     settings: &NavSettings,
     aiding: Option<&Aiding>,
     start: Start,
-    samples: I,
-    on_sample: impl FnMut(u64),
-) -> Result<RunSummary>
-where
-    I: Iterator<Item = Result<ImuSample, Fail>>,
-    Fail: std::error::Error + Send + Sync + 'static,
-{
+    samples: &mut Samples<'_>,
+    on_sample: &mut dyn FnMut(u64),
+) -> Result<RunSummary> {
+    let earth = AnyEarth::of(earth);
     let (session, feed, outputs) = open(earth, settings, aiding, start)?;
     let driven = drive(session, feed, samples, outputs, &settings.out, on_sample)?;
     conclude(&earth, settings, aiding, driven)
@@ -362,29 +362,18 @@ fn check_clocks(settings: &NavSettings, a: &Aiding, s: &Summary) -> Result<()> {
 /// [`BANK_MARGIN`] in log-likelihood (checked once a second), or `decide_after`
 /// seconds past the first sample; the most likely goes on. Returns the summary, the
 /// kept member's initial heading [rad], and the time the bank decided [s].
-#[allow(clippy::too_many_arguments)] // the run's inputs, as navigate's, plus the bank's two
-pub fn navigate_any_heading<E: EarthModel, I, Fail>(
-    earth: E,
+pub fn navigate_any_heading(
+    earth: EarthChoice,
     settings: &NavSettings,
     aiding: &Aiding,
     start: Start,
-    members: usize,
-    decide_after: f64,
-    mut samples: I,
-    on_sample: impl FnMut(u64),
-) -> Result<(RunSummary, f64, f64)>
-where
-    I: Iterator<Item = Result<ImuSample, Fail>>,
-    Fail: std::error::Error + Send + Sync + 'static,
-{
-    let (chosen, decided) = decide_heading(
-        earth,
-        settings,
-        aiding,
-        start,
-        (members, decide_after),
-        &mut samples,
-    )?;
+    (members, decide_after): (usize, f64),
+    samples: &mut Samples<'_>,
+    on_sample: &mut dyn FnMut(u64),
+) -> Result<(RunSummary, f64, f64)> {
+    let earth = AnyEarth::of(earth);
+    let bank = (members, decide_after);
+    let (chosen, decided) = decide_heading(earth, settings, aiding, start, bank, samples)?;
     let mut out = outputs(&earth, settings, Some(aiding))?;
     for e in chosen.events {
         out.event(e)?;
@@ -413,8 +402,8 @@ pub fn decide_heading<E: EarthModel, I, Fail>(
     samples: &mut I,
 ) -> Result<(Chosen<E>, f64)>
 where
-    I: Iterator<Item = Result<ImuSample, Fail>>,
-    Fail: std::error::Error + Send + Sync + 'static,
+    I: Iterator<Item = Result<ImuSample, Fail>> + ?Sized,
+    anyhow::Error: From<Fail>,
 {
     let config = settings.session_config(Some(aiding));
     let mut bank = HeadingBank::new(earth, config, start, members)
@@ -430,7 +419,7 @@ where
         bank.push(aid)?;
     }
     let (mut t0, mut checked, mut decided) = (None, f64::NEG_INFINITY, f64::NAN);
-    for s in samples.by_ref() {
+    for s in &mut *samples {
         let s = s?;
         bank.push_imu(s)?;
         decided = s.t;

@@ -20,7 +20,7 @@ use schuler_io::formats::{ImuFormat, ImuReader};
 use schuler_run::aided::Aiding;
 use schuler_run::nav::{BANK_MEMBERS, navigate_samples, parse_nav_args};
 use schuler_run::nav::{Began, InitChoice, NavArgs, NavPlan, Navigated, filter_grade};
-use schuler_run::navigate::{NavSettings, RunSummary};
+use schuler_run::navigate::{NavSettings, RunSummary, samples_of};
 use std::path::Path;
 use std::time::Instant;
 
@@ -92,14 +92,15 @@ pub fn navigate_printing<I, E>(
     aiding: &mut Option<Aiding>,
     reader: &mut I,
     bar: &ProgressBar,
-    on_sample: impl FnMut(u64),
+    mut on_sample: impl FnMut(u64),
 ) -> Result<RunSummary>
 where
     I: Iterator<Item = Result<schuler::imu::ImuSample, E>>,
     E: std::error::Error + Send + Sync + 'static,
 {
-    let on_start = |b: &Began, a: Option<&Aiding>| print_start(b, a, plan.init, bar);
-    let navigated = navigate_samples(plan, aiding, reader, on_start, on_sample)?;
+    let mut on_start = |b: &Began, a: Option<&Aiding>| print_start(b, a, plan.init, bar);
+    let mut samples = samples_of(reader);
+    let navigated = navigate_samples(plan, aiding, &mut samples, &mut on_start, &mut on_sample)?;
     print_bank(&navigated);
     Ok(navigated.summary)
 }

@@ -6,12 +6,12 @@
 use super::config::{CampaignConfig, Streams};
 use super::record::Recorded;
 use crate::aided::GivenReadings;
+use crate::earth::AnyEarth;
 use crate::nav::{InitChoice, NavConfig, plan_of, resolve_aiding};
 use crate::navigate::{NavSettings, open_session};
-use crate::options::EarthChoice;
 use anyhow::{Context, Result, bail};
 use schuler::analysis::errors::NavRecord;
-use schuler::earth::{EarthModel, Sphere, Wgs84, Wgs84Series};
+use schuler::earth::EarthModel;
 use schuler::session::Finished;
 
 /// What navigating one run gave.
@@ -103,12 +103,7 @@ pub fn navigate(c: &CampaignConfig, data: &Recorded) -> Result<Navigated> {
     }
     let settings = &plan.settings;
     let a = aiding.as_ref();
-    match settings.earth {
-        EarthChoice::Wgs84 => run_on(Wgs84, settings, a, data),
-        EarthChoice::Wgs84Series => run_on(Wgs84Series, settings, a, data),
-        EarthChoice::Sphere => run_on(Sphere::textbook(true), settings, a, data),
-        EarthChoice::SphereFixed => run_on(Sphere::textbook(false), settings, a, data),
-    }
+    run_on(AnyEarth::of(settings.earth), settings, a, data)
 }
 
 /// The session of `settings` on `earth`, every sample of `data` pushed.

@@ -450,6 +450,21 @@ impl Outputs {
     }
 }
 
+/// The IMU samples a run reads, their read errors already [`anyhow::Error`]s (as
+/// `anyhow::Error::new` of the reader's own error: the messages and the error chain
+/// are the reader's). A trait object, so that the run's code is compiled once in this
+/// crate rather than once per reader type in every crate that starts a run.
+pub type Samples<'a> = dyn Iterator<Item = Result<ImuSample>> + 'a;
+
+/// `reader`'s samples as [`Samples`]: each read error as `anyhow::Error::new(e)`.
+pub fn samples_of<I, E>(reader: I) -> impl Iterator<Item = Result<ImuSample>>
+where
+    I: Iterator<Item = Result<ImuSample, E>>,
+    E: std::error::Error + Send + Sync + 'static,
+{
+    reader.map(|s| s.map_err(anyhow::Error::new))
+}
+
 /// What a driven run leaves: the session's end and, if the input failed, the error
 /// (everything before it was written).
 pub struct Driven {
@@ -489,15 +504,11 @@ fn writer_error(pipe: WriterThread) -> anyhow::Error {
 /// out handed to the writer thread, the snapshots kept every 65,536 samples. Stops at
 /// the end of the input, at a sample that fails or at a signal; returns the count
 /// pushed and what stopped it, `None` when the writer thread stopped.
-fn push_samples<M: EarthModel, I, E>(
+fn push_samples<M: EarthModel>(
     (session, feed, pipe, snapshots): Pushing<'_, '_, M>,
-    samples: I,
-    on_sample: &mut impl FnMut(u64),
-) -> Option<(u64, Option<anyhow::Error>)>
-where
-    I: Iterator<Item = Result<ImuSample, E>>,
-    E: std::error::Error + Send + Sync + 'static,
-{
+    samples: &mut Samples<'_>,
+    on_sample: &mut dyn FnMut(u64),
+) -> Option<(u64, Option<anyhow::Error>)> {
     let mut n = 0u64;
     for s in samples {
         // A signal stops the run here, as a read error does: everything before is
@@ -505,7 +516,7 @@ where
         if let Some(i) = crate::interrupt::requested() {
             return Some((n, Some(i.into())));
         }
-        let pushed = s.map_err(anyhow::Error::new).and_then(|s| {
+        let pushed = s.and_then(|s| {
             feed.before(session, &s)?;
             session.push_imu(s).map_err(anyhow::Error::new)
         });
@@ -538,22 +549,18 @@ type Pushing<'a, 'f, M> = (
 /// count. On a read error the session ends there, its last state is written (if it
 /// was not an output epoch) and the error is returned in [`Driven::failure`] with the
 /// count and the time reached. `None` when the input held no sample at all.
-pub fn drive<M: EarthModel, I, E>(
+pub fn drive<M: EarthModel>(
     mut session: Session<M>,
     mut feed: AidFeed<'_>,
-    samples: I,
+    samples: &mut Samples<'_>,
     out: Outputs,
     dir: &Path,
-    mut on_sample: impl FnMut(u64),
-) -> Result<Option<Driven>>
-where
-    I: Iterator<Item = Result<ImuSample, E>>,
-    E: std::error::Error + Send + Sync + 'static,
-{
+    on_sample: &mut dyn FnMut(u64),
+) -> Result<Option<Driven>> {
     let mut pipe = WriterThread::spawn(out)?;
     let mut snapshots = Spilled::default();
     let pushing = (&mut session, &mut feed, &mut pipe, &mut snapshots);
-    let Some((n, mut failure)) = push_samples(pushing, samples, &mut on_sample) else {
+    let Some((n, mut failure)) = push_samples(pushing, samples, on_sample) else {
         return Err(writer_error(pipe));
     };
     if let Err(e) = feed.rest(&mut session) {

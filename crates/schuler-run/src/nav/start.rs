@@ -36,8 +36,8 @@ pub fn begin<I, E>(
     aiding: Option<&mut Aiding>,
 ) -> Result<(Start, Vec<ImuSample>, Began)>
 where
-    I: Iterator<Item = Result<ImuSample, E>>,
-    E: std::error::Error + Send + Sync + 'static,
+    I: Iterator<Item = Result<ImuSample, E>> + ?Sized,
+    anyhow::Error: From<E>,
 {
     Ok(match (align, init) {
         (Some(opts), _) => {
@@ -64,8 +64,8 @@ pub fn align_start<I, E>(
     aiding: Option<&mut Aiding>,
 ) -> Result<(Start, Vec<ImuSample>, Alignment)>
 where
-    I: Iterator<Item = Result<ImuSample, E>>,
-    E: std::error::Error + Send + Sync + 'static,
+    I: Iterator<Item = Result<ImuSample, E>> + ?Sized,
+    anyhow::Error: From<E>,
 {
     let (cfg, noise) = opts.resolve()?;
     let samples = crate::alignment::read_stage(reader, cfg.coarse + cfg.fine)?;
@@ -93,8 +93,8 @@ pub fn motion_start<I, E>(
     init: InitChoice,
 ) -> Result<(Start, Vec<ImuSample>, InMotionStart)>
 where
-    I: Iterator<Item = Result<ImuSample, E>>,
-    E: std::error::Error + Send + Sync + 'static,
+    I: Iterator<Item = Result<ImuSample, E>> + ?Sized,
+    anyhow::Error: From<E>,
 {
     use schuler::align::in_motion::{
         InMotionConfig, VELOCITY_SPAN, course_pair, start_at_fix, start_in_motion,
