@@ -2,9 +2,9 @@
 //! (a tactical IMU at 200 Hz, GNSS at 1 Hz with a lever arm and a 60-s outage,
 //! a barometer with a 3-m bias): the barometer holds the height through the outage.
 
+use crate::common;
 use predicates::prelude::*;
 use std::path::Path;
-mod common;
 
 fn vertical_max_in(nav: &Path, truth: &Path, from: f64, to: f64) -> f64 {
     let truth = common::read_rows(truth);

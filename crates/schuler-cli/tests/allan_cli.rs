@@ -5,10 +5,10 @@
 //! the warning; the log in a device's layout, read with the layout flags, gives the
 //! same table.
 
+use crate::common;
 use assert_cmd::Command;
 use predicates::prelude::*;
 use std::path::{Path, PathBuf};
-mod common;
 
 /// The simulated terms, in the units `schuler allan` prints them in.
 const ARW_DEG_SQRT_H: f64 = 0.05;

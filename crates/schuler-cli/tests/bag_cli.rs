@@ -3,7 +3,7 @@
 //! `schuler simulate`'s logs of `scenario.toml` (provenance in tests/data/README.md);
 //! `--out-bag` read back; malformed bags refused with the topic, message and field.
 
-mod common;
+use crate::common;
 
 use common::bag::{data, max_digits_apart, nav_bag, nav_text, simulate_scenario};
 use mcap::records::MessageHeader;

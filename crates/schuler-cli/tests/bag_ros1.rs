@@ -6,7 +6,7 @@
 //! The counts below are rosbags' (`Reader.connections[i].msgcount`), not ours.
 //! Truncated and garbled bags are refused with the byte offset, record and field.
 
-mod common;
+use crate::common;
 
 use schuler_io::bag::container::BagStream;
 use std::path::{Path, PathBuf};

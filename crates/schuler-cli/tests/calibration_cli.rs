@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::simulate;
 
 /// The drive of `examples/drive.toml` with `time_offset = "80 ms"` in its `[gnss]`.

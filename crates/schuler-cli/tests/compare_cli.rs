@@ -4,12 +4,12 @@
 //! interpolation is exact), malformed files, and statistics of a hand-made
 //! distribution whose percentiles follow from their definition.
 
+use crate::common;
 use assert_cmd::Command;
 use schuler::analysis::errors::EpochErrors;
 use schuler::analysis::statistics::statistics;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-mod common;
 
 use nalgebra::{Rotation3, Vector3};
 use schuler::rotation::Euler;

@@ -2,7 +2,7 @@
 //! drive made by gnss-ins-sim (not by schuler), with KF-GINS's published figures on the
 //! same data (`tests/data/README.md`).
 
-mod common;
+use crate::common;
 use nalgebra::Vector3;
 use schuler::analysis::errors::{EpochErrors, NavRecord, errors_at};
 use schuler::earth::{Geodetic, Wgs84};

@@ -7,7 +7,7 @@
 //! `tests/data/nmea` and `tests/data/rtklib` (provenance in `tests/data/README.md`)
 //! parse to the numbers they hold, checked by hand at a few epochs.
 
-mod common;
+use crate::common;
 
 use chrono::{Datelike, NaiveDate, Timelike};
 use nalgebra::{Matrix3, Vector3};

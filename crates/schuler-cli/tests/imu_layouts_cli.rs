@@ -6,7 +6,7 @@
 //! are refused with the flags that fix them; and a real device's excerpt reads with its
 //! flags.
 
-mod common;
+use crate::common;
 
 use std::ffi::OsStr;
 use std::fmt::Write as _;

@@ -2,7 +2,7 @@
 //! arm) started in motion from the fixes alone, no initial attitude given; against the
 //! simulator's truth.
 
-mod common;
+use crate::common;
 
 /// `schuler nav --init INIT` on the simulated drive in `dir` (output at 1 Hz into
 /// `dir/out`): its stdout, and the drive's folder.

@@ -3,7 +3,7 @@
 //! and a full disk (`/dev/full`) is reported with the file's name.
 #![cfg(unix)]
 
-mod common;
+use crate::common;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -8,7 +8,7 @@ use assert_cmd::Command;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 
 /// `examples/drive.toml` cut to its first 80 s (the hold and the acceleration to
 /// 20 m/s), GNSS at 1 Hz and the barometer at 10 Hz, without the outage.

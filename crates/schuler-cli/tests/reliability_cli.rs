@@ -2,7 +2,7 @@
 //! number ends the run with an error naming the time, every file written stays whole
 //! and holds no NaN; leaving the physical envelope is warned about.
 
-mod common;
+use crate::common;
 
 /// The drive9min IMU log with the x velocity increments of `rows` replaced by `dv`.
 fn corrupted(dir: &std::path::Path, rows: std::ops::Range<usize>, dv: &str) -> std::path::PathBuf {

@@ -8,7 +8,7 @@ use serde_json::Value;
 use std::ffi::OsStr;
 use std::path::Path;
 
-mod common;
+use crate::common;
 
 /// `schuler nav --gnss --baro` of the simulated drive into `out`, with `extra` flags.
 fn nav(sim: &Path, out: &Path, extra: &[&OsStr]) -> assert_cmd::assert::Assert {

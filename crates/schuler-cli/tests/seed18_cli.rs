@@ -5,8 +5,8 @@
 //! seed18 run itself writes, the report's state count, and the settings the 18 states
 //! cannot serve refused by name.
 
+use crate::common;
 use std::path::{Path, PathBuf};
-mod common;
 
 /// Decompress the drive's `IMU.txt.xz` into `dir`.
 fn imu(dir: &Path) -> PathBuf {

@@ -1,7 +1,7 @@
 //! `schuler simulate` end to end: perfect sensors round-trip through `schuler nav`,
 //! same seed gives the same bytes, bad scenarios name the key.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use predicates::prelude::*;

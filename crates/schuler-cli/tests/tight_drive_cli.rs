@@ -13,7 +13,7 @@ use serde_json::Value;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{nav_drive_gnss, simulate};
 
 use schuler::analysis::errors::errors_between;

@@ -5,6 +5,7 @@
 //! simulator's truth.nav with seeded noise (schuler::sim::vehicle); the errors come
 //! from `schuler compare` against truth.nav.
 
+use crate::common;
 use schuler::earth::Geodetic;
 use schuler::filter::Baseline;
 use schuler::nav::NavState;
@@ -13,7 +14,6 @@ use schuler::sim::vehicle::{HeadingSimulator, OdometerModel, OdometerSimulator, 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-mod common;
 
 /// The simulated drive and its vehicle logs, made once: `drive/` holds `imu.txt`,
 /// `gnss.txt`, `baro.csv`, `truth.nav`, `odometer.txt` (10 Hz, 0.3 % scale error,
