@@ -364,5 +364,59 @@ pub fn summary_dict<'py>(py: Python<'py>, f: &Finished) -> PyResult<Bound<'py, P
         .map(|h| (h.t, h.lat.to_degrees(), h.to.to_string()))
         .collect();
     d.set_item("handovers", h)?;
+    d.set_item("calibration", calibration_dict(py, f)?)?;
+    Ok(d)
+}
+
+/// The self-calibration (`estimate_lever_arm`, `estimate_gnss_time_offset`): at the
+/// end, each estimate, its standard deviation and whether the motion observed it;
+/// and its history at the snapshots (once a second). The time offset is the
+/// estimate on top of `gnss_time_offset` (added to the GNSS times as they are read).
+/// Empty without calibration.
+fn calibration_dict<'py>(py: Python<'py>, f: &Finished) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let c = &f.summary.calibration;
+    let history = PyDict::new(py);
+    let t: Vec<f64> = f.snapshots.iter().map(|s| s.t).collect();
+    if let Some(l) = &c.lever_arm {
+        d.set_item("lever_arm_m", l.value.as_slice().to_vec())?;
+        d.set_item("lever_arm_std_m", l.std.as_slice().to_vec())?;
+        d.set_item("lever_arm_observed", l.observed().to_vec())?;
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let pick = |std: bool| -> Vec<f64> {
+                f.snapshots
+                    .iter()
+                    .map(|s| {
+                        s.calibration
+                            .lever_arm
+                            .map_or(f64::NAN, |e| if std { e.std[k] } else { e.value[k] })
+                    })
+                    .collect()
+            };
+            history.set_item(format!("lever_arm_{axis}_m"), pick(false))?;
+            history.set_item(format!("lever_arm_{axis}_std_m"), pick(true))?;
+        }
+    }
+    if let Some(o) = &c.time_offset {
+        d.set_item("gnss_time_offset_s", o.value)?;
+        d.set_item("gnss_time_offset_std_s", o.std)?;
+        d.set_item("gnss_time_offset_observed", o.observed())?;
+        let pick = |std: bool| -> Vec<f64> {
+            f.snapshots
+                .iter()
+                .map(|s| {
+                    s.calibration
+                        .time_offset
+                        .map_or(f64::NAN, |e| if std { e.std } else { e.value })
+                })
+                .collect()
+        };
+        history.set_item("gnss_time_offset_s", pick(false))?;
+        history.set_item("gnss_time_offset_std_s", pick(true))?;
+    }
+    if !d.is_empty() {
+        history.set_item("t_s", t)?;
+        d.set_item("history", history)?;
+    }
     Ok(d)
 }
