@@ -165,6 +165,29 @@ pub fn run(args: NavArgs) -> Result<()> {
     print_summary(&plan, aiding.as_ref(), &summary, secs)
 }
 
+/// What the filter estimated of the set-up: the vehicle mounting and the
+/// calibrations, each ready as the flags for next time.
+fn print_estimates(aiding: &Aiding, summary: &RunSummary) {
+    if let Some((mount, [sp, sy])) = summary.nav.mounting {
+        let e = schuler::rotation::Euler::from_quaternion(&mount.q_vb);
+        println!(
+            "mounting estimated: the vehicle frame's roll {:.3}, pitch {:.3} ± {:.3}, yaw {:.3} ± {:.3} deg relative to the IMU (use as --mounting-angles)",
+            e.roll.to_degrees(),
+            e.pitch.to_degrees(),
+            sp.to_degrees(),
+            e.yaw.to_degrees(),
+            sy.to_degrees()
+        );
+    }
+    for line in schuler_run::aided::calibration::summary_lines(
+        &summary.nav.calibration,
+        &aiding.filter.integration.lever_arm,
+        aiding.gnss_time_shift,
+    ) {
+        println!("{line}");
+    }
+}
+
 /// The aided run's summary on stdout (and its outage test).
 fn print_aided(
     settings: &NavSettings,
@@ -189,24 +212,7 @@ fn print_aided(
     if let Some(line) = schuler_run::aided::vehicle::summary(&c) {
         println!("{line}");
     }
-    if let Some((mount, [sp, sy])) = summary.nav.mounting {
-        let e = schuler::rotation::Euler::from_quaternion(&mount.q_vb);
-        println!(
-            "mounting estimated: the vehicle frame's roll {:.3}, pitch {:.3} ± {:.3}, yaw {:.3} ± {:.3} deg relative to the IMU (use as --mounting-angles)",
-            e.roll.to_degrees(),
-            e.pitch.to_degrees(),
-            sp.to_degrees(),
-            e.yaw.to_degrees(),
-            sy.to_degrees()
-        );
-    }
-    for line in schuler_run::aided::calibration::summary_lines(
-        &summary.nav.calibration,
-        &aiding.filter.integration.lever_arm,
-        aiding.gnss_time_shift,
-    ) {
-        println!("{line}");
-    }
+    print_estimates(aiding, summary);
     if let Some(test) = &aiding.outage_test {
         schuler_run::aided::report_outage_test(
             &settings.out.join("nav.txt"),
