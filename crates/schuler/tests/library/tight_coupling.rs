@@ -459,8 +459,8 @@ fn the_lever_arm_and_the_time_offset_calibrate_through_the_ranges() {
         after(&cal),
         after(&truth)
     );
-    for i in 0..3 {
-        assert!((l.value[i] - LEVER[i]).abs() < 3.0 * l.std[i], "axis {i}");
+    for (i, truth) in LEVER.iter().enumerate() {
+        assert!((l.value[i] - truth).abs() < 3.0 * l.std[i], "axis {i}");
     }
     assert!((t.value - tau).abs() < 3.0 * t.std);
     assert!(l.observed()[0] && l.observed()[1] && t.observed());
