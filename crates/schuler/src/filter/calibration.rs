@@ -177,8 +177,8 @@ impl AntennaMotion {
         lever: &Vector3<f64>,
         p: &DMatrix<f64>,
     ) -> Self {
-        let c_bc = frame.q_bc.to_rotation_matrix().into_inner();
-        let w_eb_b = w_ib_b - c_bc.transpose() * frame.w_ie_c;
+        let antenna = super::ranging::Antenna::of(frame, lever, w_ib_b);
+        let c_bc = antenna.c_bc;
         let g_c = Vector3::new(0.0, 0.0, frame.gravity);
         let f_c = c_bc * f_ib_b;
         let a = f_c + g_c - (2.0 * frame.w_ie_c + frame.rho_c).cross(&frame.v_c);
@@ -189,8 +189,8 @@ impl AntennaMotion {
             + Matrix3::from_diagonal_element(f_var);
         Self {
             c_bc,
-            w_eb_b,
-            v_a: frame.v_c + c_bc * w_eb_b.cross(lever),
+            w_eb_b: antenna.w_eb_b,
+            v_a: frame.v_c + antenna.lever_v_c,
             a,
             p_v: block(Layout::VEL),
             p_a,

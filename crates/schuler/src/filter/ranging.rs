@@ -176,8 +176,10 @@ impl Tight {
 
 /// The antenna's ECEF position and velocity (relative to the Earth) from the
 /// mechanization's frame, lever arm `lever` (body) and compensated body rate `w_ib_b`;
-/// with the lever arm in `c` and the lever-arm velocity in `c`.
+/// with the body rate relative to the Earth (body axes), the lever arm in `c` and the
+/// lever-arm velocity in `c`.
 pub(crate) struct Antenna {
+    pub w_eb_b: Vector3<f64>,
     pub r_e: Vector3<f64>,
     pub v_e: Vector3<f64>,
     pub l_c: Vector3<f64>,
@@ -194,6 +196,7 @@ impl Antenna {
         let w_eb = w_ib_b - c_bc.transpose() * frame.w_ie_c;
         let lever_v_c = c_bc * w_eb.cross(lever);
         Self {
+            w_eb_b: w_eb,
             r_e: frame.r_e + c_ec * l_c,
             v_e: c_ec * (frame.v_c + lever_v_c),
             l_c,
