@@ -25,6 +25,11 @@
 //! its instant (after the estimate moved back past a fix already due) has its
 //! prediction carried there, `z += (H_r v_a + H_v a) g + H_r a g²/2`.
 //!
+//! While the offset's σ is wide, the linear model misses `½ h_ττ δτ²` (the turn's
+//! entry or the braking that the next second of prior holds); its variance is added
+//! to the measurement's noise, the truncated second-order filter's term
+//! ([`add_second_order_noise`]).
+//!
 //! The offset's column is left out of a row whose rate `H_r v_a + H_v a` is within
 //! three of its own standard deviations (from the covariance of `δv` and of the
 //! acceleration error `f^c × ψ + Ĉ_cb δb_a`, and the specific force's noise): the
@@ -163,6 +168,39 @@ pub(crate) struct AntennaMotion {
     pub p_v: Matrix3<f64>,
     /// Covariance of the acceleration estimate [m²/s⁴].
     pub p_a: Matrix3<f64>,
+    /// The acceleration's rate of change over the last GNSS interval [m/s³]
+    /// ([`JerkMemory`]).
+    pub jerk: Vector3<f64>,
+    /// The variance of the time offset's residual `δτ` [s²] (zero when not estimated).
+    pub tau_var: f64,
+}
+
+/// The acceleration at the last GNSS epoch, for the rate of change the second-order
+/// term of the time offset needs (module doc): `j = (a − a₀)/(t − t₀)` over the last
+/// interval of half a second or more, zero after a gap of more than [`Self::SPAN`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct JerkMemory {
+    last: Option<(f64, Vector3<f64>)>,
+    jerk: Vector3<f64>,
+}
+
+impl JerkMemory {
+    /// The longest interval a difference is taken over [s].
+    const SPAN: f64 = 3.0;
+
+    /// Remember the acceleration `a` at `t` (when half a second or more has passed
+    /// since the last) and give the current rate of change.
+    pub fn update(&mut self, t: f64, a: &Vector3<f64>) -> Vector3<f64> {
+        let since = self.last.map_or(f64::INFINITY, |(t0, _)| t - t0);
+        if since >= 0.5 {
+            self.jerk = match self.last {
+                Some((t0, a0)) if since <= Self::SPAN => (a - a0) / (t - t0),
+                _ => Vector3::zeros(),
+            };
+            self.last = Some((t, *a));
+        }
+        self.jerk
+    }
 }
 
 impl AntennaMotion {
@@ -194,8 +232,24 @@ impl AntennaMotion {
             a,
             p_v: block(Layout::VEL),
             p_a,
+            jerk: Vector3::zeros(),
+            tau_var: 0.0,
         }
     }
+}
+
+/// The truncated second-order filter's noise for the offset (Gelb 1974 §6.1): the
+/// measurement's second derivative in `τ`, `h_ττ = H_r a + H_v j`, adds
+/// `½ h_ττ h_ττᵀ σ_τ⁴` to its covariance. While `σ_τ` is wide (a prior of seconds)
+/// this is what the linear model misses across a turn's entry or a braking (at 1 s
+/// and 2.5 m/s³, 1.2 m/s), and without it an accurate velocity fix pulls the offset
+/// to a wrong minimum; once `σ_τ` is a few milliseconds it is nothing.
+fn add_second_order_noise(m: &mut Measurement, k: &AntennaMotion) {
+    let rows = m.z.len();
+    let h_tt = nalgebra::DVector::from_fn(rows, |row, _| {
+        (columns(&m.h, row, Layout::POS) * k.a + columns(&m.h, row, Layout::VEL) * k.jerk)[0]
+    });
+    m.r += &h_tt * h_tt.transpose() * (0.5 * k.tau_var * k.tau_var);
 }
 
 fn columns(h: &DMatrix<f64>, row: usize, at: usize) -> RowVector3<f64> {
@@ -213,6 +267,9 @@ pub(crate) fn add_columns(
     seen: &mut Excitation,
 ) {
     let lever_v = k.c_bc * skew(&k.w_eb_b);
+    if layout.time_offset.is_some() {
+        add_second_order_noise(m, k);
+    }
     for row in 0..m.z.len() {
         let h_r = columns(&m.h, row, Layout::POS);
         let h_v = columns(&m.h, row, Layout::VEL);
@@ -351,5 +408,57 @@ mod tests {
         for r in 0..3 {
             assert_eq!(v.h[(r, o)], -a[r]);
         }
+    }
+
+    /// The second-order noise is the variance of the term the linear model drops: for
+    /// a position, `½ a δτ²` with `δτ ~ N(0, σ²)` has variance `¼ a aᵀ (3σ⁴ − σ⁴)` =
+    /// `½ a aᵀ σ⁴` (Gaussian fourth moment); for a velocity the same with the jerk.
+    #[test]
+    fn second_order_noise_is_the_dropped_terms_variance() {
+        let f = frame();
+        let layout = Layout::core().with_time_offset();
+        let fix = Geodetic::new(0.7, 0.2, 101.0);
+        let std = Vector3::repeat(1.0);
+        let w_ib = Vector3::new(0.0, 0.0, 0.3);
+        let f_ib = Vector3::new(1.5, 0.4, -9.7);
+        let cov = DMatrix::zeros(layout.n, layout.n);
+        let mut k = AntennaMotion::of(&f, &w_ib, &f_ib, 0.0, &Vector3::zeros(), &cov);
+        k.jerk = Vector3::new(2.0, -1.0, 0.5);
+        k.tau_var = 0.25;
+        let sigma4 = k.tau_var * k.tau_var;
+        let mut p = gnss_position(&Wgs84, &layout, &f, &fix, &std, &Vector3::zeros());
+        let r0 = p.r.clone();
+        add_columns(&mut p, &layout, &k, 0.0, &mut Excitation::default());
+        let mut v = gnss_velocity(&layout, &f, &fix, &f.v_c, &std, &Vector3::zeros(), &w_ib);
+        add_columns(&mut v, &layout, &k, 0.0, &mut Excitation::default());
+        // The fixes' rows are in `c` with unit position and velocity columns.
+        for (m, d2) in [(&p, k.a), (&v, k.jerk)] {
+            let added = &m.r - &r0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    let want = 0.5 * d2[i] * d2[j] * sigma4;
+                    assert!(
+                        (added[(i, j)] - want).abs() < 1e-9 * (1.0 + want.abs()),
+                        "{i}{j}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The jerk is the acceleration's difference over the last interval of half a
+    /// second or more, kept between; nothing after a gap.
+    #[test]
+    fn jerk_memory() {
+        let mut j = JerkMemory::default();
+        let a = |t: f64| Vector3::new(1.0 + 2.0 * t, -t, 0.0);
+        assert_eq!(j.update(0.0, &a(0.0)), Vector3::zeros());
+        assert_eq!(j.update(1.0, &a(1.0)), Vector3::new(2.0, -1.0, 0.0));
+        // The velocity fix of the same epoch sees the same jerk.
+        assert_eq!(
+            j.update(1.0, &Vector3::zeros()),
+            Vector3::new(2.0, -1.0, 0.0)
+        );
+        assert_eq!(j.update(5.0, &a(5.0)), Vector3::zeros());
     }
 }

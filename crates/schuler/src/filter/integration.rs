@@ -314,6 +314,8 @@ pub struct Integrator<M: ErrorFrame, E: EarthModel> {
     t_start: f64,
     /// What the motion showed of the calibrations so far.
     excitation: calibration::Excitation,
+    /// The antenna's acceleration at the last GNSS epoch and its rate of change.
+    jerk: calibration::JerkMemory,
     /// The measurements tested, refused and skipped, the counts and gate resets.
     pub book: GateBook,
     /// The record for the smoother, when smoothing.
@@ -403,6 +405,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
         Self {
             t_start: state.t,
             excitation: Default::default(),
+            jerk: Default::default(),
             mech,
             earth,
             model,
@@ -607,12 +610,12 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
 
     /// The antenna's motion now and the gap to the instant of a GNSS measurement
     /// stamped `t`.
-    fn antenna_motion(&self, t: f64) -> (AntennaMotion, f64) {
+    fn antenna_motion(&mut self, t: f64) -> (AntennaMotion, f64) {
         let frame = self.mech.frame();
         let gap = t + self.gnss_time_offset() - frame.t;
         // White accelerometer noise over the last sample: VRW² / dt.
         let f_var = self.cfg.noise.vrw.norm_squared() / 3.0 / self.f_dt.max(1e-6);
-        let k = AntennaMotion::of(
+        let mut k = AntennaMotion::of(
             &frame,
             &self.w_ib_b,
             &self.f_ib_b,
@@ -620,6 +623,12 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             &self.lever_arm(),
             &self.kf.p,
         );
+        k.jerk = self.jerk.update(frame.t, &k.a);
+        k.tau_var = self
+            .model
+            .layout
+            .time_offset
+            .map_or(0.0, |o| self.kf.p[(o, o)]);
         (k, gap)
     }
 
@@ -736,6 +745,7 @@ impl<M: ErrorFrame, E: EarthModel> Integrator<M, E> {
             f_dt: self.f_dt,
             t_start: self.t_start,
             excitation: self.excitation,
+            jerk: self.jerk,
             book: self.book,
             smoother: self.smoother,
             tight: self.tight,
