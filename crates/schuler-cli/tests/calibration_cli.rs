@@ -53,13 +53,7 @@ fn nav_estimates_the_lever_arm_and_the_time_offset_and_says_what_it_saw() {
         .arg("--gnss-vel")
         .arg(sim.join("gnss.csv"))
         .args(["--init-pos", "45.07,7.68,245", "--init-att", "0,0,10"])
-        .args([
-            "--imu-grade",
-            "tactical",
-            "--output-rate",
-            "1",
-            "--no-report",
-        ])
+        .args(["--imu-grade", "tactical", "--output-rate", "1"])
         .args(["--estimate-lever-arm", "--estimate-gnss-time-offset"])
         .arg("--out")
         .arg(&out)
@@ -86,6 +80,47 @@ fn nav_estimates_the_lever_arm_and_the_time_offset_and_says_what_it_saw() {
     }
     let (v, sd) = tau[0];
     assert!((v - 0.08).abs() < 3.0 * sd, "offset {v} ± {sd}");
+    // The report plots each estimate and writes its history once a second: a
+    // constant's variance never grows in a Kalman filter (its transition row is the
+    // identity, it has no process noise, an update only lowers it), so each σ column
+    // is non-increasing (to the covariance update's rounding, 1e-12 relative) down to
+    // the σ the run printed at its end (that is the update after the last second's
+    // row; to its printed decimals).
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert!(html.contains("Self-calibration") && html.contains("from the motion alone"));
+    let csv = std::fs::read_to_string(out.join("report/calibration.csv")).expect("csv");
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            // An empty field: no value (the motion alone knows nothing at the start).
+            l.split(',')
+                .map(|v| {
+                    if v.is_empty() {
+                        f64::NAN
+                    } else {
+                        v.parse().expect("number")
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    assert!(rows.len() > 1000, "{} rows", rows.len());
+    for (k, (_, printed_sd)) in lever.iter().chain(&tau).enumerate() {
+        let (col, scale, half) = match k {
+            3 => (2 + 3 * k, 1e3, 0.5e-4 * 1.001),
+            _ => (2 + 3 * k, 1.0, 0.5e-3 * 1.001),
+        };
+        for w in rows.windows(2) {
+            assert!(w[1][0] > w[0][0]);
+            assert!(w[1][col] <= w[0][col] * (1.0 + 1e-12), "{k}: {w:?}");
+        }
+        let last = rows.last().expect("rows")[col] / scale;
+        assert!(
+            *printed_sd <= last + half,
+            "{k}: printed {printed_sd}, last row {last}"
+        );
+    }
     let next = line("use next time: ");
     assert!(
         next.contains("--lever-arm ") && next.contains("--gnss-time-offset "),

@@ -21,6 +21,8 @@
 //! narrower than a single run's spread; the Monte-Carlo test in the library
 //! (`tests/gnss_integration.rs`) is the sharp one.
 
+mod calibration;
+
 use super::record::{InnovationRow, ReportSample};
 use super::series::{Series, series};
 use super::spilled::Spilled;
@@ -321,14 +323,21 @@ fn with_envelope(
     center: &[f64],
     sigma3: &[f64],
 ) -> Plot {
+    let (xb, yb) = envelope(t, center, sigma3);
+    plot.line(name, t, y, LineStyle::Solid)
+        .line(band, &xb, &yb, LineStyle::Dashed)
+}
+
+/// The points of the envelope `center ± sigma3` as one series: the upper bound, a
+/// break, the lower bound.
+fn envelope(t: &[f64], center: &[f64], sigma3: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let mut yb: Vec<f64> = center.iter().zip(sigma3).map(|(c, s)| c + s).collect();
     yb.push(f64::NAN);
     yb.extend(center.iter().zip(sigma3).map(|(c, s)| c - s));
     let mut xb = t.to_vec();
     xb.push(f64::NAN);
     xb.extend_from_slice(t);
-    plot.line(name, t, y, LineStyle::Solid)
-        .line(band, &xb, &yb, LineStyle::Dashed)
+    (xb, yb)
 }
 
 /// What every section needs: where plots and CSVs go (`OUT/report/`), the run's
@@ -504,6 +513,7 @@ fn build(
 
     position_section(&mut r, c)?;
     sensor_section(&mut r, c)?;
+    calibration::section(&mut r, c)?;
     innovation_section(&mut r, c)?;
     nis_section(&mut r, c, nis)?;
     if let Some(nees) = nees {
