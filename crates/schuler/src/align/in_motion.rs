@@ -3,7 +3,9 @@
 //!
 //! The start is taken at the middle `t_m` of a pair of fixes `(i, j)`: the first pair
 //! whose horizontal displacement `d` exceeds [`InMotionConfig::displacement_sigmas`]
-//! times its standard deviation within [`InMotionConfig::max_interval`], or, among the
+//! times its standard deviation within [`InMotionConfig::max_interval`] (for a vehicle
+//! too slow for that, a longer chord up to [`InMotionConfig::max_straight_interval`]
+//! over which the gyros say it drove straight), or, among the
 //! pairs ending up to [`InMotionConfig::settle`] later on a straight chord, the one
 //! with the largest displacement against its deviation (a car that just drove off has
 //! a far longer chord a few seconds later):
@@ -58,6 +60,11 @@ pub struct InMotionConfig {
     pub settle: f64,
     /// A chord counts as straight while the gyros turn less than this [rad] over it.
     pub straight: f64,
+    /// Longest time between the two fixes of a straight chord [s]: when no pair
+    /// moved far enough within [`Self::max_interval`] (a rover creeping at 0.2 m/s
+    /// with 1-m fixes needs 70 s), a longer pair serves if the gyros turned less than
+    /// [`Self::straight`] over it (its course is then the heading however long it is).
+    pub max_straight_interval: f64,
 }
 
 impl Default for InMotionConfig {
@@ -69,6 +76,7 @@ impl Default for InMotionConfig {
             sideslip: 1f64.to_radians(),
             settle: 3.0,
             straight: 2f64.to_radians(),
+            max_straight_interval: 300.0,
         }
     }
 }
@@ -99,7 +107,8 @@ pub enum InMotionError {
     #[error(
         "the GNSS fixes never moved {sigmas} standard deviations apart within {max_interval} s \
          (largest horizontal displacement {best:.2} m against its std {std:.2} m): \
-         no course to take the heading from; start from a known attitude instead"
+         no course to take the heading from; --init gnss-any-heading finds the heading \
+         with a bank of filters instead, or start from a known attitude"
     )]
     NoMotion {
         /// The criterion.
@@ -110,6 +119,22 @@ pub enum InMotionError {
         best: f64,
         /// Its standard deviation [m].
         std: f64,
+    },
+    /// The only chord long enough is longer than [`InMotionConfig::max_interval`]
+    /// and not straight: its course is not the heading.
+    #[error(
+        "the GNSS fixes moved far enough for a course only from t = {t0} s to t = {t1} s, \
+         while the vehicle turned {turned_deg:.1} deg: no straight chord to take the \
+         heading from; --init gnss-any-heading finds the heading with a bank of filters \
+         instead, or start from a known attitude"
+    )]
+    NotStraight {
+        /// The earlier fix's time [s].
+        t0: f64,
+        /// The later fix's time [s].
+        t1: f64,
+        /// The angle the gyros turned over the chord [deg].
+        turned_deg: f64,
     },
     /// Fewer than two fixes, or none after the start's first in time.
     #[error(
@@ -164,7 +189,10 @@ fn displacement_std(a: &GnssFix, b: &GnssFix) -> f64 {
 }
 
 /// The first pair of fixes far enough apart: `(i, j)` with the shortest interval
-/// ending at the earliest fix `j`, or the best displacement seen as an error.
+/// ending at the earliest fix `j`, within [`InMotionConfig::max_interval`] or else
+/// within [`InMotionConfig::max_straight_interval`] (the caller checks that such a
+/// long chord is straight); or the best displacement seen within the first as an
+/// error.
 pub fn course_pair<E: EarthModel>(
     earth: &E,
     fixes: &[GnssFix],
@@ -177,27 +205,34 @@ pub fn course_pair<E: EarthModel>(
         });
     }
     let (mut best, mut best_std) = (0.0f64, None);
-    for j in 1..fixes.len() {
-        for i in (0..j).rev() {
-            if fixes[j].t - fixes[i].t > cfg.max_interval {
-                break;
-            }
-            let d = displacement(earth, &fixes[i].pos, &fixes[j].pos)
-                .xy()
-                .norm();
-            let std = displacement_std(&fixes[i], &fixes[j]);
-            if d >= cfg.displacement_sigmas * std {
-                return Ok((i, j));
-            }
-            if best_std.is_none() || d > best {
-                (best, best_std) = (d, Some(std));
+    // Short chords first; then, for a slow vehicle, long ones (straight: checked by
+    // the caller, who has the gyros).
+    for longest in [
+        cfg.max_interval,
+        cfg.max_straight_interval.max(cfg.max_interval),
+    ] {
+        for j in 1..fixes.len() {
+            for i in (0..j).rev() {
+                if fixes[j].t - fixes[i].t > longest {
+                    break;
+                }
+                let d = displacement(earth, &fixes[i].pos, &fixes[j].pos)
+                    .xy()
+                    .norm();
+                let std = displacement_std(&fixes[i], &fixes[j]);
+                if d >= cfg.displacement_sigmas * std {
+                    return Ok((i, j));
+                }
+                if best_std.is_none() || d > best {
+                    (best, best_std) = (d, Some(std));
+                }
             }
         }
     }
     match best_std {
         Some(std) => Err(InMotionError::NoMotion {
             sigmas: cfg.displacement_sigmas,
-            max_interval: cfg.max_interval,
+            max_interval: cfg.max_straight_interval.max(cfg.max_interval),
             best,
             std,
         }),
@@ -353,7 +388,17 @@ pub fn start_in_motion<E: EarthModel>(
     fixes: &[GnssFix],
     cfg: &InMotionConfig,
 ) -> Result<InMotionStart, InMotionError> {
-    let (i, j) = best_pair(earth, samples, fixes, course_pair(earth, fixes, cfg)?, cfg);
+    let first = course_pair(earth, fixes, cfg)?;
+    let (t0, t1) = (fixes[first.0].t, fixes[first.1].t);
+    let turned_over = turned(samples, t0, t1);
+    if t1 - t0 > cfg.max_interval && turned_over.abs() >= cfg.straight {
+        return Err(InMotionError::NotStraight {
+            t0,
+            t1,
+            turned_deg: turned_over.to_degrees(),
+        });
+    }
+    let (i, j) = best_pair(earth, samples, fixes, first, cfg);
     let mut start = start_at_fix(earth, samples, fixes, i, j, cfg)?;
     let (a, b) = (&fixes[i], &fixes[j]);
     // The course of the chord is the heading at its middle; the gyros carry it on.
