@@ -46,6 +46,10 @@ enum Command {
     /// Error budget: the filter's covariance along a scenario's truth and each error
     /// source's share of it (sigma.csv, shares.csv).
     Budget(schuler_cli::commands::budget::Args),
+    /// What device logs hold (PX4 ULog, ROS bags, u-blox UBX, ArduPilot DataFlash,
+    /// Android GnssLogger): streams, rates, gaps, GNSS quality, the IMU's units and
+    /// axes, and the `schuler nav` command line that navigates each.
+    Inspect(schuler_cli::commands::inspect::Args),
 }
 
 /// `cmd` and its subcommands with every option that takes a value accepting one that
@@ -83,6 +87,7 @@ fn main() -> ExitCode {
         Command::Gnss(args) => schuler_cli::commands::gnss::run(args),
         Command::Montecarlo(args) => schuler_cli::commands::montecarlo::run(args),
         Command::Budget(args) => schuler_cli::commands::budget::run(args),
+        Command::Inspect(args) => schuler_cli::commands::inspect::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -26,6 +26,7 @@ mod gnss_formats_cli;
 mod gnss_stations;
 mod imu_layouts_cli;
 mod init_gnss_cli;
+mod inspect_cli;
 #[cfg(unix)]
 mod interrupt_cli;
 mod layers;

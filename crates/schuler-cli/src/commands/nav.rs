@@ -127,11 +127,14 @@ pub fn print_summary(
 }
 
 /// `schuler nav` on an IMU log (`--kf-gins-config` is dispatched before, by
-/// [`crate::commands::run_nav`]; `--bag` goes to [`schuler_run::bag_input::run`]).
+/// [`crate::commands::run_nav`]; `--bag` goes to [`schuler_run::bag_input::run`], `--log` to [`super::nav_log::run`]).
 pub fn run(args: NavArgs) -> Result<()> {
     let plan = parse_nav_args(args)?;
     if plan.bag.bag.is_some() {
         return super::nav_bag::run(plan);
+    }
+    if plan.log.log.is_some() {
+        return super::nav_log::run(plan);
     }
     let mut aiding: Option<Aiding> = plan.aiding.resolve(filter_grade(&plan).noise()?)?;
     let settings = &plan.settings;

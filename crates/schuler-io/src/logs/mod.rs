@@ -21,9 +21,12 @@
 
 pub mod clock;
 pub mod dataflash;
+pub mod detect;
 pub mod gnss_logger;
 pub mod ubx;
 pub mod ulog;
+
+pub use detect::{LogFormat, detect};
 
 use nalgebra::Vector3;
 use schuler::earth::Geodetic;
@@ -146,4 +149,19 @@ pub trait LogReader: Iterator<Item = Result<LogItem, crate::formats::InputError>
     fn time_scale(&self) -> TimeScale;
     /// Bytes read so far and the file's size, for progress.
     fn progress(&self) -> (u64, u64);
+}
+
+/// Opens the log at `path`, of `format` ([`detect`]), as its reader; `None` for a ROS
+/// bag, which [`crate::bag`] reads.
+pub fn open_reader(
+    path: &std::path::Path,
+    format: LogFormat,
+) -> Result<Option<Box<dyn LogReader>>, crate::formats::InputError> {
+    Ok(Some(match format {
+        LogFormat::Ulog => Box::new(ulog::UlogReader::open(path)?),
+        LogFormat::Ubx => Box::new(ubx::UbxReader::open(path)?),
+        LogFormat::Dataflash => Box::new(dataflash::DataflashReader::open(path)?),
+        LogFormat::GnssLogger => Box::new(gnss_logger::GnssLoggerReader::open(path)?),
+        LogFormat::Ros1Bag | LogFormat::Mcap => return Ok(None),
+    }))
 }

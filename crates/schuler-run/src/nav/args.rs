@@ -6,6 +6,7 @@ use crate::alignment::AlignOptions;
 use crate::bag_input::BagArgs;
 use crate::flat_options::{keys_of, partition, read_group, unknown_option};
 use crate::imu_input::ImuInputOptions;
+use crate::log_input::LogArgs;
 use crate::options::{EarthChoice, GravityChoice, MechanizationChoice, Triple};
 use anyhow::{Context, Result};
 use serde::Deserialize;
@@ -101,6 +102,9 @@ pub struct NavArgs {
     /// ROS bags: `--bag` as the input (ROS 1 or 2), `--out-bag` for the result.
     #[command(flatten)]
     pub bag: BagArgs,
+    /// Device logs: `--log` as the input (ULog, UBX, GnssLogger, DataFlash, bags).
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// The same options as data: a TOML file's keys ([`load_config`]; alignment options in
@@ -136,6 +140,9 @@ pub struct NavConfig {
     pub(crate) base_frame: Option<String>,
     pub(crate) out_bag: Option<PathBuf>,
     pub(crate) leap_seconds: Option<i64>,
+    pub(crate) log: Option<PathBuf>,
+    pub(crate) imu_stream: Option<String>,
+    pub(crate) gnss_stream: Option<String>,
     /// The IMU input keys, read apart ([`ImuInputOptions::split_config`]).
     #[serde(skip)]
     pub(crate) input: ImuInputOptions,
@@ -162,7 +169,13 @@ pub(super) fn load_config(path: &Path) -> Result<NavConfig> {
         ImuInputOptions::split_config(&text).with_context(|| format!("in {}", path.display()))?;
     cfg.input = input;
     let base = path.parent().unwrap_or(Path::new(""));
-    let paths = [&mut cfg.imu, &mut cfg.out, &mut cfg.bag, &mut cfg.out_bag];
+    let paths = [
+        &mut cfg.imu,
+        &mut cfg.out,
+        &mut cfg.bag,
+        &mut cfg.out_bag,
+        &mut cfg.log,
+    ];
     for p in paths.into_iter().flatten() {
         if p.is_relative() {
             *p = base.join(&*p);
@@ -207,6 +220,15 @@ impl NavConfig {
             base_frame: self.base_frame.clone(),
             out_bag: self.out_bag.clone(),
             leap_seconds: self.leap_seconds,
+        }
+    }
+
+    /// The device-log keys (the path already relative to the file's folder).
+    pub(super) fn log_args(&self) -> LogArgs {
+        LogArgs {
+            log: self.log.clone(),
+            imu_stream: self.imu_stream.clone(),
+            gnss_stream: self.gnss_stream.clone(),
         }
     }
 }

@@ -6,6 +6,7 @@ use crate::aided::{Aiding, AidingOptions, GivenReadings};
 use crate::alignment::AlignOptions;
 use crate::bag_input::BagArgs;
 use crate::imu_input::ImuInputOptions;
+use crate::log_input::LogArgs;
 use crate::navigate::NavSettings;
 use crate::options::{GradeChoice, Triple, rate};
 use anyhow::{Context, Result, anyhow, bail};
@@ -69,6 +70,9 @@ pub struct NavPlan {
     pub axes_given: bool,
     /// The bag flags over the configuration's bag keys.
     pub bag: BagArgs,
+    /// The device-log flags over the configuration's keys (a bag given as `--log`
+    /// is in [`NavPlan::bag`] too).
+    pub log: LogArgs,
 }
 
 /// The initial position of flags over config, checked.
@@ -139,14 +143,21 @@ fn plan(args: NavArgs, cfg: NavConfig) -> Result<NavPlan> {
     }
     let input = args.input.clone().or(cfg.input.clone());
     let axes_given = input.imu_axes.is_some() || input.imu_rotation.is_some();
-    let bag = args.bag.clone().or(cfg.bag_args());
+    let mut bag = args.bag.clone().or(cfg.bag_args());
+    let log = args.log.clone().or(cfg.log_args());
+    if let Some(path) = &log.log {
+        check_log_input(&input, &bag, args.imu.is_some() || cfg.imu.is_some())?;
+        if schuler_io::logs::detect(path)?.is_bag() {
+            bag.bag = Some(path.clone());
+        }
+    }
     if bag.bag.is_some() {
         check_bag_input(&input)?;
         if args.imu.is_some() || cfg.imu.is_some() {
             bail!("an IMU log and a bag are both given (--imu or `imu`, --bag or `bag`): give one");
         }
     }
-    let settings = settings(&args, &cfg, &bag, in_motion, align_on)?;
+    let settings = settings(&args, &cfg, (&bag, &log), in_motion, align_on)?;
     let alignment = args
         .alignment
         .clone()
@@ -171,6 +182,7 @@ fn plan(args: NavArgs, cfg: NavConfig) -> Result<NavPlan> {
         aiding,
         axes_given,
         bag,
+        log,
     })
 }
 
@@ -189,7 +201,7 @@ fn config_files_exist<'a>(files: impl Iterator<Item = (&'a str, &'a Path)>) -> R
 fn settings(
     args: &NavArgs,
     cfg: &NavConfig,
-    bag: &BagArgs,
+    (bag, log): (&BagArgs, &LogArgs),
     in_motion: bool,
     align_on: bool,
 ) -> Result<NavSettings> {
@@ -199,8 +211,9 @@ fn settings(
             .clone()
             .or(cfg.imu.clone())
             .or(bag.bag.clone())
+            .or(log.log.clone())
             .context(
-                "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config) or --bag BAG",
+                "no IMU log: give --imu FILE (or `imu = \"FILE\"` in the config), --bag BAG or --log FILE",
             )?,
         read: read_options(args, cfg)?,
         init_pos: if in_motion {
@@ -241,7 +254,18 @@ fn settings(
 /// The IMU input options that say how a text log is laid out have no meaning for a
 /// bag (its messages say it): refused rather than ignored.
 fn check_bag_input(input: &ImuInputOptions) -> Result<()> {
-    for (given, flag) in [
+    match text_log_flag(input) {
+        Some(flag) => bail!(
+            "{flag} does not apply to --bag: sensor_msgs/Imu holds rates in rad/s and \
+             m/s^2 with header stamps"
+        ),
+        None => Ok(()),
+    }
+}
+
+/// The first flag given that describes a text IMU log's layout, units or clock.
+fn text_log_flag(input: &ImuInputOptions) -> Option<&'static str> {
+    [
         (input.imu_format.is_some(), "--imu-format"),
         (input.imu_layout.is_some(), "--imu-layout"),
         (input.imu_columns.is_some(), "--imu-columns"),
@@ -249,15 +273,26 @@ fn check_bag_input(input: &ImuInputOptions) -> Result<()> {
         (input.accel_unit.is_some(), "--accel-unit"),
         (input.imu_time_unit.is_some(), "--imu-time-unit"),
         (input.imu_rate.is_some(), "--imu-rate"),
-    ] {
-        if given {
-            bail!(
-                "{flag} does not apply to --bag: sensor_msgs/Imu holds rates in rad/s and \
-                 m/s^2 with header stamps"
-            );
-        }
+    ]
+    .into_iter()
+    .find_map(|(given, flag)| given.then_some(flag))
+}
+
+/// A device log (`--log`) with an IMU log or a bag beside it, or with flags that
+/// describe a text IMU log: refused rather than ignored.
+fn check_log_input(input: &ImuInputOptions, bag: &BagArgs, imu_given: bool) -> Result<()> {
+    if imu_given || bag.bag.is_some() {
+        bail!(
+            "--log and an IMU log or a bag are both given (--imu, --bag or their keys): give one"
+        );
     }
-    Ok(())
+    match text_log_flag(input) {
+        Some(flag) => bail!(
+            "{flag} does not apply to --log: a device log's reader converts its units, \
+             axes and clock itself"
+        ),
+        None => Ok(()),
+    }
 }
 
 /// The filter's IMU grade: `--imu-grade`, else navigation grade for alignment
