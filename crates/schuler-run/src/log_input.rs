@@ -137,8 +137,9 @@ fn choose(
         Some(name) => match of_kind.iter().find(|&&i| reader.streams()[i].name == name) {
             Some(&i) => Ok(Some(i)),
             None => bail!(
-                "{}: no {kind:?} stream named {name:?} with records; it has: {}",
+                "{}: no {} stream named {name:?} with records; it has: {}",
                 path.display(),
+                crate::inspect::kind_name(kind).to_uppercase(),
                 if of_kind.is_empty() {
                     "none".to_owned()
                 } else {
