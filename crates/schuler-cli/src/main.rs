@@ -69,8 +69,38 @@ fn hyphen_values(cmd: clap::Command) -> clap::Command {
     .mut_subcommands(hyphen_values)
 }
 
+/// Exit status of a tool whose output pipe was closed: 128 + SIGPIPE, what the shell
+/// reports for a program the signal ended.
+const BROKEN_PIPE_STATUS: i32 = 141;
+
+/// `schuler … | head`: once the reader of stdout has gone, the print macros panic on
+/// the broken pipe (Rust ignores SIGPIPE, and restoring the signal's default needs
+/// `unsafe`, which the workspace forbids). This hook ends the process quietly with
+/// [`BROKEN_PIPE_STATUS`] there, as a tool the signal ended would; any other panic
+/// goes to the default hook. The files a command writes are finished before it prints
+/// its summary, so nothing written is lost.
+fn quiet_on_broken_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        // std's message: "failed printing to stdout: Broken pipe (os error 32)".
+        if message.starts_with("failed printing to stdout")
+            && message.to_ascii_lowercase().contains("broken pipe")
+        {
+            std::process::exit(BROKEN_PIPE_STATUS);
+        }
+        default(info);
+    }));
+}
+
 fn main() -> ExitCode {
     use clap::{CommandFactory, FromArgMatches};
+    quiet_on_broken_pipe();
     let matches = hyphen_values(Cli::command()).get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command {

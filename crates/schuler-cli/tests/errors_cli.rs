@@ -89,3 +89,26 @@ fn a_failed_write_is_stated_once() {
     );
     assert_eq!(stderr.matches("imu.txt").count(), 1, "{stderr}");
 }
+
+/// `schuler inspect FILE | head -0`: the reader of stdout is gone before the first
+/// line (the pipe's read end is closed before the process starts, so every write
+/// fails), and the run ends quietly with 141 (128 + SIGPIPE, as `cat` killed by the
+/// signal would), not with a panic's message and 101.
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_ends_the_run_quietly() {
+    let (reader, writer) = std::io::pipe().expect("pipe");
+    drop(reader);
+    let log = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/dataflash/synthetic_circle.bin.gz");
+    let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("schuler"))
+        .arg("inspect")
+        .arg(log)
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(141), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
