@@ -85,6 +85,17 @@ impl fmt::Display for InputError {
     }
 }
 
+/// The error of a file that cannot be opened or read: `PATH: cannot read: reason`.
+pub(crate) fn cannot_read(path: &Path, e: &std::io::Error) -> InputError {
+    InputError::new(
+        InputErrorKind::Io,
+        path,
+        0,
+        None,
+        format!("cannot read: {e}"),
+    )
+}
+
 /// `value` (in `domain`'s display unit) in SI if it is within `domain`; else an
 /// [`InputErrorKind::OutOfDomain`] error naming `path`, `line` and `field`.
 pub fn in_domain(

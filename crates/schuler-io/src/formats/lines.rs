@@ -113,15 +113,7 @@ pub fn read_config_text(path: &Path) -> Result<String, InputError> {
     })
 }
 
-pub(crate) fn cannot_read(path: &Path, e: &std::io::Error) -> InputError {
-    InputError::new(
-        InputErrorKind::Io,
-        path,
-        0,
-        None,
-        format!("cannot read: {e}"),
-    )
-}
+pub(crate) use super::error::cannot_read;
 
 /// The error of line `n` longer than [`MAX_LINE_BYTES`].
 pub(crate) fn too_long(path: &Path, n: u64) -> InputError {

@@ -16,7 +16,7 @@
 //! [`NavReader`] reads a file an epoch at a time; [`read_nav`] reads it whole (80
 //! bytes per epoch).
 
-use super::error::{InputError, InputErrorKind, in_domain, quote_field};
+use super::error::{InputError, InputErrorKind, cannot_read, in_domain, quote_field};
 use super::gps_time::WeekClock;
 use super::lines::{Delimiter, MAX_LINE_BYTES, fields, is_skippable, too_long};
 use nalgebra::Vector3;
@@ -72,17 +72,6 @@ const TIME_ALIAS: &str = "t";
 const KF_GINS_VALUES: [&str; 10] = [
     "sow", "lat", "lon", "h", "vn", "ve", "vd", "roll", "pitch", "yaw",
 ];
-
-/// The error of a file that cannot be opened or read.
-fn cannot_read(path: &Path, e: std::io::Error) -> InputError {
-    InputError::new(
-        InputErrorKind::Io,
-        path,
-        0,
-        None,
-        format!("cannot read: {e}"),
-    )
-}
 
 /// Field `field` of line `n` parsed from `text`: a finite number.
 fn number(path: &Path, n: u64, field: &str, text: &str) -> Result<f64, InputError> {
@@ -236,7 +225,7 @@ pub struct NavReader {
 impl NavReader {
     /// Opens `path`.
     pub fn open(path: &Path) -> Result<Self, InputError> {
-        let file = std::fs::File::open(path).map_err(|e| cannot_read(path, e))?;
+        let file = std::fs::File::open(path).map_err(|e| cannot_read(path, &e))?;
         Ok(Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(1 << 16, file),
@@ -263,7 +252,7 @@ impl NavReader {
             if (&mut self.reader)
                 .take(MAX_LINE_BYTES)
                 .read_until(b'\n', &mut self.buf)
-                .map_err(|e| cannot_read(path, e))?
+                .map_err(|e| cannot_read(path, &e))?
                 == 0
             {
                 return Ok(None);

@@ -16,6 +16,7 @@
 
 use crate::formats::InputError;
 use crate::formats::error::InputErrorKind;
+use crate::formats::error::cannot_read;
 use std::io::Read;
 use std::path::Path;
 
@@ -96,15 +97,7 @@ impl LogFormat {
 /// The format of the log at `path` (a file, plain or gzip; or a rosbag2 directory).
 /// A file no signature matches is refused naming it and what was looked for.
 pub fn detect(path: &Path) -> Result<LogFormat, InputError> {
-    let io = |e: std::io::Error| {
-        InputError::new(
-            InputErrorKind::Io,
-            path,
-            0,
-            None,
-            format!("cannot read: {e}"),
-        )
-    };
+    let io = |e: std::io::Error| cannot_read(path, &e);
     if path.is_dir() {
         return match crate::bag::container::files_of(path) {
             Ok(_) => Ok(LogFormat::Mcap),

@@ -12,7 +12,7 @@ pub mod raw;
 pub mod write;
 
 use crate::formats::InputError;
-use crate::formats::error::InputErrorKind;
+use crate::formats::error::cannot_read;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
@@ -23,15 +23,7 @@ const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 /// The file at `path` as a buffered stream of its text, gunzipped when it begins with
 /// gzip's magic bytes (whatever its name).
 pub(crate) fn open(path: &Path) -> Result<Box<dyn BufRead + Send>, InputError> {
-    let io = |e: std::io::Error| {
-        InputError::new(
-            InputErrorKind::Io,
-            path,
-            0,
-            None,
-            format!("cannot read: {e}"),
-        )
-    };
+    let io = |e: std::io::Error| cannot_read(path, &e);
     let mut file = BufReader::with_capacity(1 << 20, File::open(path).map_err(io)?);
     let gzipped = file.fill_buf().map_err(io)?.starts_with(&GZIP_MAGIC);
     Ok(if gzipped {
@@ -86,6 +78,6 @@ mod tests {
         std::fs::write(gz.path(), enc.finish().unwrap()).unwrap();
         assert_eq!(read_all(open(gz.path()).unwrap()), text);
         let missing = open(Path::new("/no/such/file.rnx")).err().unwrap();
-        assert_eq!(missing.kind, InputErrorKind::Io);
+        assert_eq!(missing.kind, crate::formats::error::InputErrorKind::Io);
     }
 }

@@ -53,6 +53,7 @@ pub mod rxm;
 use super::{LogItem, LogReader, LogRecord, ReferenceSample, Stream, StreamKind, TimeScale};
 use crate::formats::InputError;
 use crate::formats::error::InputErrorKind;
+use crate::formats::error::cannot_read;
 use frame::{Piece, Scanner};
 use schuler::imu::ImuSample;
 use std::collections::{HashMap, VecDeque};
@@ -217,15 +218,7 @@ impl UbxReader {
 
     /// As [`UbxReader::open`], with options.
     pub fn open_with(path: &Path, options: UbxOptions) -> Result<Self, InputError> {
-        let io = |e: std::io::Error| {
-            InputError::new(
-                InputErrorKind::Io,
-                path,
-                0,
-                None,
-                format!("cannot read: {e}"),
-            )
-        };
+        let io = |e: std::io::Error| cannot_read(path, &e);
         let file = File::open(path).map_err(io)?;
         let size = file.metadata().map_err(io)?.len();
         let mut buffered = BufReader::with_capacity(1 << 16, file);
